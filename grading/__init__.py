@@ -1,0 +1,37 @@
+"""The course autograder.
+
+* :mod:`grading.plugin` -- pytest plugin: the ``impl`` fixture that hands the
+  implementation under test to graded tests, points per test, per-test
+  timeouts, short feedback and the results file.
+* :mod:`grading.implementation` -- loads an implementation (a student's
+  ``pcl_course/``, the reference ``solutions/``) without importing it as
+  ``pcl_course``.
+* :mod:`grading.checks` -- assertions with student-readable messages.
+* :mod:`grading.cli` -- ``python -m grading grade ...``.
+"""
+
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+GRADED_TESTS = REPO_ROOT / "tests" / "graded"
+
+# Graded function -> exercise module; every name in ../shared/course-api.md.
+GRADED_FUNCTIONS = {
+    "pca": "pca",
+    "kernel_matrix": "pca",
+    "kernel_pca": "pca",
+    "kernel_pca_transform": "pca",
+    "fit_plane": "normals",
+    "estimate_normals": "normals",
+    "voxel_grid_downsample": "downsampling",
+    "approximate_voxel_downsample": "downsampling",
+    "farthest_point_sampling": "downsampling",
+    "normal_space_sampling": "downsampling",
+    "radius_outlier_removal": "filters",
+    "statistical_outlier_removal": "filters",
+    "bilateral_filter_image": "filters",
+    "bilateral_filter_points": "filters",
+    "joint_bilateral_upsample": "filters",
+    "chamfer_distance": "metrics",
+    "depth_metrics": "metrics",
+}

@@ -1,0 +1,77 @@
+"""Assertions for graded tests, with messages a student can act on.
+
+Each helper raises ``AssertionError`` whose message says what was expected
+and what came back (shapes and a few values), never a hidden answer in full.
+"""
+
+import numpy as np
+
+_DTYPE_KINDS = {"float64": np.float64, "int64": np.int64, "bool": np.bool_}
+
+
+def preview(array, n=4):
+    """The first few values of an array, for feedback."""
+    array = np.asarray(array)
+    flat = array.ravel()
+    head = np.array2string(flat[:n], precision=5, separator=", ")
+    more = f" ... ({flat.size} values)" if flat.size > n else ""
+    return f"{head}{more}"
+
+
+def check_array(value, name, shape=None, dtype="float64"):
+    """Check that ``value`` is a plain ``np.ndarray`` of ``shape`` and ``dtype``.
+
+    ``shape`` may hold ``None`` for a free dimension. Returns ``value``.
+    """
+    if type(value) is not np.ndarray:
+        raise AssertionError(
+            f"{name} must be a plain numpy.ndarray, got {type(value).__module__}."
+            f"{type(value).__qualname__}"
+        )
+    if dtype is not None and value.dtype != _DTYPE_KINDS[dtype]:
+        raise AssertionError(f"{name} must have dtype {dtype}, got {value.dtype}")
+    if shape is not None:
+        ok = value.ndim == len(shape) and all(
+            s is None or s == v for s, v in zip(shape, value.shape)
+        )
+        if not ok:
+            want = "(" + ", ".join("*" if s is None else str(s) for s in shape) + ")"
+            raise AssertionError(f"{name} must have shape {want}, got {value.shape}")
+    return value
+
+
+def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
+    """``np.allclose`` with a message naming the worst entry."""
+    actual = np.asarray(actual, dtype=float)
+    expected = np.asarray(expected, dtype=float)
+    if actual.shape != expected.shape:
+        raise AssertionError(f"{name}: expected shape {expected.shape}, got {actual.shape}")
+    if np.allclose(actual, expected, rtol=rtol, atol=atol, equal_nan=True):
+        return
+    error = np.abs(actual - expected)
+    error = np.where(np.isnan(error), np.inf, error)
+    worst = np.unravel_index(np.argmax(error), error.shape)
+    message = (
+        f"{name} is wrong: at index {tuple(int(i) for i in worst)} expected "
+        f"{expected[worst]:.6g}, got {actual[worst]:.6g}\n"
+        f"  got {preview(actual)}"
+    )
+    if hint:
+        message += f"\n  hint: {hint}"
+    raise AssertionError(message)
+
+
+def check_unit_columns_match(actual, expected, name, atol=1e-6, hint=""):
+    """Columns of ``actual`` equal those of ``expected`` up to sign each."""
+    dots = np.abs(np.sum(np.asarray(actual) * np.asarray(expected), axis=0))
+    norms = np.linalg.norm(actual, axis=0)
+    bad = np.flatnonzero(~(np.isclose(dots, 1.0, atol=atol) & np.isclose(norms, 1.0, atol=atol)))
+    if bad.size:
+        i = int(bad[0])
+        message = (
+            f"{name}: column {i} is not the expected unit vector (up to sign): "
+            f"|cos angle| = {dots[i]:.6f}, norm = {norms[i]:.6f}"
+        )
+        if hint:
+            message += f"\n  hint: {hint}"
+        raise AssertionError(message)

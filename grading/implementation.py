@@ -1,0 +1,114 @@
+"""Load the implementation under test from a directory of exercise modules.
+
+The directory is a student's ``pcl_course/``, the reference ``solutions/`` or
+any folder with the same module files. It is imported as a private package
+(``_graded_impl_<n>``), never as ``pcl_course``, so the trusted helpers of
+this repository stay what the tests use.
+"""
+
+import importlib.util
+import itertools
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from grading import GRADED_FUNCTIONS
+
+_counter = itertools.count()
+
+
+class NotImplementedYet(Exception):
+    """A graded function is still the stub (it raised NotImplementedError)."""
+
+    def __init__(self, function):
+        super().__init__(f"not implemented: {function}() raises NotImplementedError")
+        self.function = function
+
+
+class StudentError(Exception):
+    """The implementation under test raised an unexpected exception."""
+
+
+def describe(value):
+    """A short description of an argument or result, for feedback."""
+    if isinstance(value, np.ndarray):
+        return f"<array {value.shape} {value.dtype}>"
+    if isinstance(value, (list, tuple)) and len(value) > 4:
+        return f"<{type(value).__name__} of {len(value)}>"
+    if isinstance(value, np.random.Generator):
+        return "<Generator>"
+    text = repr(value)
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def describe_call(name, args, kwargs):
+    parts = [describe(a) for a in args] + [f"{k}={describe(v)}" for k, v in kwargs.items()]
+    return f"{name}({', '.join(parts)})"
+
+
+class Implementation:
+    """The graded functions of one implementation, as attributes.
+
+    ``impl.pca(points)`` calls the implementation's ``pca``. Each call is
+    recorded (:attr:`last_call`) for feedback; a stub's
+    ``NotImplementedError`` becomes :class:`NotImplementedYet`.
+
+    Parameters
+    ----------
+    directory : path
+        Folder holding the exercise modules (``pca.py``, ...).
+    overrides : dict, optional
+        Module name -> file that replaces that module (used to grade one
+        module of a wrong submission against the reference for the rest).
+    """
+
+    def __init__(self, directory, overrides=None):
+        self.directory = Path(directory).resolve()
+        self.overrides = {k: Path(v).resolve() for k, v in (overrides or {}).items()}
+        self.package = f"_graded_impl_{next(_counter)}"
+        self._modules = {}
+        self.last_call = None
+        self._make_package()
+
+    def _make_package(self):
+        init = self.directory / "__init__.py"
+        spec = importlib.util.spec_from_file_location(
+            self.package,
+            init if init.exists() else None,
+            submodule_search_locations=[str(self.directory)],
+        )
+        package = importlib.util.module_from_spec(spec)
+        sys.modules[self.package] = package
+        if init.exists():
+            spec.loader.exec_module(package)
+
+    def module(self, name):
+        if name not in self._modules:
+            path = self.overrides.get(name, self.directory / f"{name}.py")
+            if not path.exists():
+                raise FileNotFoundError(f"the implementation has no module {name}.py")
+            qualified = f"{self.package}.{name}"
+            spec = importlib.util.spec_from_file_location(qualified, path)
+            module = importlib.util.module_from_spec(spec)
+            sys.modules[qualified] = module
+            spec.loader.exec_module(module)
+            self._modules[name] = module
+        return self._modules[name]
+
+    def __getattr__(self, name):
+        if name not in GRADED_FUNCTIONS:
+            raise AttributeError(name)
+        function = getattr(self.module(GRADED_FUNCTIONS[name]), name, None)
+        if function is None:
+            raise StudentError(f"{GRADED_FUNCTIONS[name]}.py defines no function {name}")
+
+        def graded_call(*args, **kwargs):
+            self.last_call = describe_call(name, args, kwargs)
+            try:
+                return function(*args, **kwargs)
+            except NotImplementedError:
+                raise NotImplementedYet(name) from None
+
+        graded_call.__name__ = name
+        return graded_call

@@ -1,0 +1,173 @@
+"""pytest plugin of the autograder.
+
+A graded test is a test that takes the ``impl`` fixture: the implementation
+under test, whose graded functions are its attributes (``impl.pca(...)``).
+Graded tests never import ``pcl_course`` or ``solutions`` exercises directly.
+
+Options
+-------
+--impl DIR
+    Folder of exercise modules to grade (default: ``pcl_course/`` under the
+    rootdir, i.e. the student's own code).
+--impl-module MODULE=FILE
+    Replace one module of ``--impl`` by a file (repeatable).
+--results FILE
+    Write the Gradescope results JSON there.
+
+Markers
+-------
+``@pytest.mark.points(n)``: what the test is worth (default 1).
+``@pytest.mark.timeout(s)``: its time limit (default :data:`DEFAULT_TIMEOUT`).
+"""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from grading.implementation import Implementation, NotImplementedYet
+
+DEFAULT_TIMEOUT = 60.0  # seconds per graded test, ample for plain-loop solutions
+MAX_FEEDBACK_LINES = 12
+
+_IMPL_KEY = pytest.StashKey[Implementation]()
+_RESULTS_KEY = pytest.StashKey[dict]()
+
+
+def pytest_addoption(parser):
+    group = parser.getgroup("grading", "course autograder")
+    group.addoption("--impl", default=None, metavar="DIR",
+                    help="folder of exercise modules to grade (default: ./pcl_course)")
+    group.addoption("--impl-module", action="append", default=[], metavar="MODULE=FILE",
+                    help="replace one exercise module of --impl by FILE")
+    group.addoption("--results", default=None, metavar="FILE",
+                    help="write the results (Gradescope JSON) to FILE")
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "points(n): marks that a graded test is worth")
+    config.stash[_RESULTS_KEY] = {}
+
+
+def _implementation(config):
+    if _IMPL_KEY not in config.stash:
+        directory = config.getoption("--impl")
+        directory = Path(directory) if directory else config.rootpath / "pcl_course"
+        overrides = {}
+        for item in config.getoption("--impl-module"):
+            module, sep, path = item.partition("=")
+            if not sep:
+                raise pytest.UsageError(f"--impl-module takes MODULE=FILE, got {item!r}")
+            overrides[module] = path
+        config.stash[_IMPL_KEY] = Implementation(directory, overrides)
+    return config.stash[_IMPL_KEY]
+
+
+@pytest.fixture(scope="session")
+def impl(request):
+    """The implementation under test; its graded functions are attributes."""
+    return _implementation(request.config)
+
+
+def _is_graded(item):
+    return "impl" in getattr(item, "fixturenames", ())
+
+
+def _points(item):
+    marker = item.get_closest_marker("points")
+    return float(marker.args[0]) if marker else 1.0
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if _is_graded(item) and item.get_closest_marker("timeout") is None:
+            item.add_marker(pytest.mark.timeout(DEFAULT_TIMEOUT))
+
+
+def _location_in_implementation(excinfo, impl):
+    roots = [impl.directory, *impl.overrides.values()]
+    for entry in reversed(excinfo.traceback):
+        path = Path(str(entry.path))
+        if any(path == root or root in path.parents for root in roots):
+            return f"{path.name}:{entry.lineno + 1} in {entry.name}"
+    return None
+
+
+def _feedback(excinfo, impl):
+    """One short, readable explanation of a failure."""
+    exc = excinfo.value
+    last_call = f"\n  last call: {impl.last_call}" if impl and impl.last_call else ""
+    if isinstance(exc, NotImplementedYet):
+        return str(exc)
+    text = str(exc).strip()
+    if excinfo.typename == "Failed" and text.startswith("Timeout"):
+        return f"timed out: {text.splitlines()[0]}{last_call}"
+    if excinfo.typename == "Failed" and text.startswith("DID NOT RAISE"):
+        expected = text.removeprefix("DID NOT RAISE").strip()
+        return f"expected the call to raise {expected}, but it returned normally{last_call}"
+    if isinstance(exc, AssertionError):
+        lines = text.splitlines()[:MAX_FEEDBACK_LINES] or ["assertion failed"]
+        return "\n".join(lines) + last_call
+    where = _location_in_implementation(excinfo, impl) if impl else None
+    where = f"\n  at {where}" if where else ""
+    first = text.splitlines()[0] if text else ""
+    return f"raised {excinfo.typename}: {first}{where}{last_call}"
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    if not _is_graded(item):
+        return
+    report = outcome.get_result()
+    results = item.config.stash[_RESULTS_KEY]
+    entry = results.setdefault(item.nodeid, {
+        "name": item.name,
+        "score": 0.0,
+        "max_score": _points(item),
+        "status": "failed",
+        "output": "",
+    })
+    if report.when == "call" and report.passed:
+        entry.update(score=entry["max_score"], status="passed", output="")
+    elif report.failed:
+        impl = item.config.stash.get(_IMPL_KEY, None)
+        message = _feedback(call.excinfo, impl) if call.excinfo else "failed"
+        if report.when != "call":
+            message = f"error in test {report.when}: {message}"
+        entry.update(score=0.0, status="failed", output=message)
+        if isinstance(call.excinfo.value if call.excinfo else None, NotImplementedYet):
+            report.longrepr = message  # one line, not a traceback
+    elif report.skipped and report.when != "teardown":
+        entry.update(score=0.0, status="failed", output="skipped")
+
+
+def results_summary(results):
+    tests = list(results.values())
+    return {
+        "score": sum(t["score"] for t in tests),
+        "max_score": sum(t["max_score"] for t in tests),
+        "tests": tests,
+    }
+
+
+def pytest_sessionfinish(session, exitstatus):
+    results = session.config.stash.get(_RESULTS_KEY, {})
+    path = session.config.getoption("--results")
+    if path and not hasattr(session.config, "workerinput"):
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(results_summary(results), indent=2))
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    results = config.stash.get(_RESULTS_KEY, {})
+    if not results:
+        return
+    summary = results_summary(results)
+    terminalreporter.write_sep("=", "marks")
+    for test in summary["tests"]:
+        terminalreporter.write_line(
+            f"{test['score']:5.1f} / {test['max_score']:<4.1f} {test['name']}"
+        )
+    terminalreporter.write_line(f"Total: {summary['score']:g} / {summary['max_score']:g}")

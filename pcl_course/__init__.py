@@ -1,0 +1,10 @@
+"""3D Point Cloud Processing, Lecture 1: the student package.
+
+Exercise modules (implement the stubs): :mod:`pca`, :mod:`normals`,
+:mod:`downsampling`, :mod:`filters`, :mod:`metrics`.
+
+Complete helpers (use them): :mod:`validation`, :mod:`datasets`, :mod:`io`,
+:mod:`neighbors`, :mod:`plotting`, :mod:`book`.
+"""
+
+EXERCISE_MODULES = ("pca", "normals", "downsampling", "filters", "metrics")

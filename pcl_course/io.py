@@ -1,0 +1,63 @@
+"""Readers and writers of the point cloud file formats the course uses (complete).
+
+* ModelNet40 ``modelnet40_normal_resampled`` text files: one point per line,
+  ``x,y,z,nx,ny,nz``, comma-separated.
+* KITTI velodyne scans ``.bin``: little-endian float32 records
+  ``x, y, z, intensity``.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from pcl_course.validation import as_array, as_points
+
+__all__ = ["read_modelnet_txt", "write_modelnet_txt", "read_kitti_bin", "write_kitti_bin"]
+
+
+def read_modelnet_txt(path):
+    """Read a ModelNet ``x,y,z,nx,ny,nz`` text file.
+
+    Returns
+    -------
+    points : ndarray of float64, shape (N, 3)
+    normals : ndarray of float64, shape (N, 3)
+    """
+    data = np.loadtxt(path, delimiter=",", dtype=np.float64, ndmin=2)
+    if data.shape[1] != 6:
+        raise ValueError(f"{path}: expected 6 comma-separated columns, got {data.shape[1]}")
+    return data[:, :3].copy(), data[:, 3:].copy()
+
+
+def write_modelnet_txt(path, points, normals):
+    """Write points and normals as a ModelNet ``x,y,z,nx,ny,nz`` text file."""
+    points = as_points(points, columns=3)
+    normals = as_points(normals, "normals", columns=3)
+    if normals.shape != points.shape:
+        raise ValueError(f"normals must have the shape of points {points.shape}, got {normals.shape}")
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    np.savetxt(path, np.hstack([points, normals]), fmt="%.6f", delimiter=",")
+
+
+def read_kitti_bin(path):
+    """Read a KITTI velodyne scan.
+
+    Returns
+    -------
+    scan : ndarray of float32, shape (N, 4)
+        Columns x, y, z (metres, sensor frame) and intensity.
+    """
+    raw = np.fromfile(path, dtype="<f4")
+    if raw.size % 4:
+        raise ValueError(f"{path}: size is not a whole number of (x, y, z, intensity) records")
+    return raw.reshape(-1, 4)
+
+
+def write_kitti_bin(path, points, intensity):
+    """Write points ``(N, 3)`` and intensity ``(N,)`` as a KITTI velodyne ``.bin``."""
+    points = as_points(points, columns=3)
+    intensity = as_array(intensity, "intensity", ndim=1)
+    if intensity.shape[0] != points.shape[0]:
+        raise ValueError(f"intensity must have {points.shape[0]} values, got {intensity.shape[0]}")
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    np.hstack([points, intensity[:, None]]).astype("<f4").tofile(path)

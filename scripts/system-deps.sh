@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Install the Debian packages the course needs, or say exactly how to.
+#   libusb-1.0-0 : `import open3d` fails without libusb-1.0.so.0
+set -euo pipefail
+
+missing=()
+ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0' || missing+=(libusb-1.0-0)
+
+[ ${#missing[@]} -eq 0 ] && exit 0
+
+if [ "$(id -u)" -eq 0 ] && command -v apt-get >/dev/null 2>&1; then
+    echo "Installing system packages: ${missing[*]}"
+    export DEBIAN_FRONTEND=noninteractive
+    apt-get update -qq
+    apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+    echo "Missing system packages: ${missing[*]}" >&2
+    echo "Install them, then run make again:" >&2
+    echo "    sudo apt-get install -y ${missing[*]}" >&2
+    exit 1
+fi
