@@ -44,7 +44,7 @@ def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), 
         # The grader's own configuration only: nothing from the submission.
         "-c", str(REPO_ROOT / "grading" / "pytest.ini"),
         "--rootdir", str(REPO_ROOT),
-        "-p", "grading.plugin", "-p", "no:cacheprovider",
+        "-p", "grading.plugin", "-p", "no:cacheprovider", "-p", "no:dash",
         "--impl", str(impl_dir), "--results", str(results),
         "-q", "--tb=no", "--no-header", "-rN",
     ]
@@ -93,7 +93,8 @@ def grade(args):
         print(f"error: the grading run broke (pytest exit code {code})", file=sys.stderr)
         return 1
     summary = json.loads(results.read_text())
-    print(format_report(summary, f"Grading {impl_dir}"))
+    title = f"Grading {impl_dir}" + "".join(f" (with {o})" for o in args.impl_module)
+    print(format_report(summary, title))
     if args.results:
         print(f"Results written to {results}")
     return 0

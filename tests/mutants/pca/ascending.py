@@ -1,0 +1,14 @@
+"""Returns eigh's ascending order even with sort=True."""
+
+import numpy as np
+
+from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
+from solutions.pca import pca as _reference  # noqa: F401
+from pcl_course.validation import as_points
+
+
+def pca(points, correlation=False, sort=True):
+    x = as_points(points, min_columns=1, allow_empty=False)
+    xc = x - x.mean(axis=0)
+    w, v = np.linalg.eigh(xc.T @ xc / len(x))
+    return w, v

@@ -1,0 +1,14 @@
+"""Centres with one scalar mean over all coordinates instead of one mean per column."""
+
+import numpy as np
+
+from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
+from solutions.pca import pca as _reference  # noqa: F401
+from pcl_course.validation import as_points
+
+
+def pca(points, correlation=False, sort=True):
+    x = as_points(points, min_columns=1, allow_empty=False)
+    xc = x - x.mean()
+    w, v = np.linalg.eigh(xc.T @ xc / len(x))
+    return w[::-1].copy(), v[:, ::-1].copy()

@@ -1,0 +1,17 @@
+"""Uses scipy.linalg.eig, whose eigenvalues are always complex, and sorts by the real part."""
+
+import numpy as np
+
+from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
+from solutions.pca import pca as _reference  # noqa: F401
+from pcl_course.validation import as_points
+
+import scipy.linalg
+
+
+def pca(points, correlation=False, sort=True):
+    x = as_points(points, min_columns=1, allow_empty=False)
+    xc = x - x.mean(axis=0)
+    w, v = scipy.linalg.eig(xc.T @ xc / len(x))
+    order = np.argsort(-w.real)
+    return w[order], v[:, order]

@@ -1,0 +1,92 @@
+"""The grader grades right: full marks for the reference, zero for the stubs,
+and lost points for every wrong submission in tests/mutants."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from grading import GRADED_FUNCTIONS, REPO_ROOT
+
+MUTANTS = sorted((REPO_ROOT / "tests" / "mutants").glob("*/*.py"))
+
+
+def grade(*args, tmp_path):
+    results = tmp_path / "results.json"
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "grade", *args, "--results", str(results)],
+        cwd=REPO_ROOT, capture_output=True, text=True, timeout=900,
+    )
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    return json.loads(results.read_text()), completed.stdout
+
+
+def test_reference_gets_full_marks(tmp_path):
+    summary, stdout = grade("--reference", tmp_path=tmp_path)
+    failed = [f"{t['name']}: {t['output']}" for t in summary["tests"] if t["status"] != "passed"]
+    assert not failed, "the reference loses points:\n" + "\n".join(failed)
+    assert summary["score"] == summary["max_score"] > 0
+    assert f"Total: {summary['score']:g} / {summary['max_score']:g}" in stdout
+
+
+def test_results_file_has_the_gradescope_format(tmp_path):
+    summary, _ = grade("--reference", "-k", "test_pca_", tmp_path=tmp_path)
+    assert set(summary) == {"score", "max_score", "tests"}
+    for test in summary["tests"]:
+        assert set(test) == {"name", "score", "max_score", "status", "output"}
+        assert test["status"] in ("passed", "failed")
+        assert 0 <= test["score"] <= test["max_score"]
+
+
+def test_stubs_get_zero_with_one_not_implemented_line_per_test(tmp_path):
+    summary, stdout = grade(str(REPO_ROOT), tmp_path=tmp_path)
+    assert summary["score"] == 0 and summary["max_score"] > 0
+    for test in summary["tests"]:
+        assert test["output"].startswith("not implemented: "), test
+        assert "\n" not in test["output"], test
+    assert "Traceback" not in stdout
+    assert stdout.count("not implemented: ") == len(summary["tests"])
+
+
+def test_every_graded_test_names_its_function(tmp_path):
+    summary, _ = grade("--reference", tmp_path=tmp_path)
+    for test in summary["tests"]:
+        assert any(f"test_{f}_" in test["name"] for f in GRADED_FUNCTIONS), test["name"]
+
+
+def test_keyword_selects_one_exercise(tmp_path):
+    summary, _ = grade("--reference", "-k", "test_pca_", tmp_path=tmp_path)
+    assert summary["tests"] and all(t["name"].startswith("test_pca_") for t in summary["tests"])
+
+
+def test_no_matching_test_is_a_usage_error():
+    completed = subprocess.run([sys.executable, "-m", "grading", "grade", "--reference", "-k", "no_such_test"],
+                               cwd=REPO_ROOT, capture_output=True, text=True)
+    assert completed.returncode == 2 and "no graded test matches" in completed.stderr
+
+
+@pytest.mark.parametrize("mutant", MUTANTS, ids=[f"{m.parent.name}/{m.stem}" for m in MUTANTS])
+def test_wrong_submission_loses_points(mutant, tmp_path):
+    function = mutant.parent.name
+    module = GRADED_FUNCTIONS[function]
+    summary, _ = grade("--reference", "--impl-module", f"{module}={mutant}", "-k", f"test_{function}_",
+                       tmp_path=tmp_path)
+    assert summary["tests"], f"no test of {function} ran"
+    assert summary["score"] < summary["max_score"], (
+        f"{mutant.relative_to(REPO_ROOT)} ({mutant.read_text().splitlines()[0]}) keeps full marks"
+    )
+
+
+ALTERNATIVES = sorted((REPO_ROOT / "tests" / "alternatives").glob("*/*.py"))
+
+
+@pytest.mark.parametrize("variant", ALTERNATIVES, ids=[f"{m.parent.name}/{m.stem}" for m in ALTERNATIVES])
+def test_other_correct_submission_gets_full_marks(variant, tmp_path):
+    function = variant.parent.name
+    module = GRADED_FUNCTIONS[function]
+    summary, _ = grade("--reference", "--impl-module", f"{module}={variant}", "-k", f"test_{function}_",
+                       tmp_path=tmp_path)
+    failed = [f"{t['name']}: {t['output']}" for t in summary["tests"] if t["status"] != "passed"]
+    assert summary["tests"] and not failed, f"{variant.name} loses points:\n" + "\n".join(failed)
