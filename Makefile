@@ -21,9 +21,17 @@ $(STAMP): requirements.txt pyproject.toml scripts/system-deps.sh
 	$(BIN)/python -c "import open3d, numpy, scipy, sklearn"
 	touch $@
 
+# The execution cache keys on each page's own code only: when the package code
+# the pages run changes, drop the cache (and Sphinx's saved environment, or it
+# would not even re-read the pages) so that every page runs again.
+CODE_STAMP := _build/.code-stamp
+$(CODE_STAMP): $(wildcard pcl_course/*.py solutions/*.py)
+	rm -rf _build/.jupyter_cache _build/.doctrees
+	mkdir -p _build && touch $@
+
 # -W -n --keep-going: a failing cell (raise_on_error in _config.yml) or a
 # broken reference fails the build, and every problem is reported at once.
-book: setup
+book: setup $(CODE_STAMP)
 	$(BIN)/jupyter-book build . -W -n --keep-going
 	@echo "The book is in _build/html: open $(CURDIR)/_build/html/index.html"
 

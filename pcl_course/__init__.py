@@ -8,3 +8,9 @@ Complete helpers (use them): :mod:`validation`, :mod:`datasets`, :mod:`io`,
 """
 
 EXERCISE_MODULES = ("pca", "normals", "downsampling", "filters", "metrics")
+
+import os as _os
+
+# Open3D starts a WebRTC visualiser (and prints about it) when imported in
+# Jupyter; the book draws with matplotlib and Plotly and needs neither.
+_os.environ.setdefault("OPEN3D_DISABLE_WEB_VISUALIZER", "true")

@@ -1,0 +1,111 @@
+"""The built book (``make book`` first; ``make test`` does it): every chapter
+executed, math rendered from local files, nothing from the network, no error
+output, no reference code."""
+
+import html as html_module
+import re
+
+import pytest
+import yaml
+
+from grading import REPO_ROOT
+
+HTML = REPO_ROOT / "_build" / "html"
+
+
+def toc_files():
+    toc = yaml.safe_load((REPO_ROOT / "_toc.yml").read_text())
+    files = [toc["root"]]
+    for part in toc.get("parts", []):
+        files += [chapter["file"] for chapter in part["chapters"]]
+    return files
+
+
+def page(name):
+    path = HTML / f"{name}.html"
+    if not HTML.is_dir():
+        pytest.fail("the book is not built: run `make book` (make test does it first)")
+    assert path.is_file(), f"{path} is missing"
+    return path.read_text(encoding="utf-8")
+
+
+def all_pages():
+    return sorted(HTML.rglob("*.html"))
+
+
+@pytest.mark.parametrize("name", toc_files())
+def test_every_page_is_built(name):
+    assert "<html" in page(name)
+
+
+@pytest.mark.parametrize("name", [f for f in toc_files() if (REPO_ROOT / f"{f}.md").read_text().count("{code-cell}")])
+def test_chapters_are_executed_without_errors_or_warnings(name):
+    html = page(name)
+    source = (REPO_ROOT / f"{name}.md").read_text()
+    assert html.count('class="cell_output') > 0, f"{name}: no executed output"
+    assert "output stderr" not in html, f"{name}: a cell wrote to stderr (a warning?)"
+    assert "output traceback" not in html and "Traceback (most recent call last)" not in html
+    n_figures = source.count("  figure:\n")
+    assert html.count("<figure") >= n_figures, f"{name}: fewer figures than captions"
+
+
+def test_pca_chapter_shows_its_numerical_checks():
+    html = page("book/pca")
+    for line in ("lambda_k = sigma_k^2 / N: True", "first PC of deflated = u_2: True",
+                 "ours x N/(N-1) == sklearn: True", "same canonical coordinates: True"):
+        assert line.replace(">", "&gt;") in html or line in html, line
+    assert 'id="thm-pca"' in html
+
+
+def test_math_is_rendered_by_local_mathjax():
+    html = page("book/pca")
+    assert html.count('class="math') > 20
+    scripts = re.findall(r'<script[^>]*src="([^"]*)"', html)
+    mathjax = [s for s in scripts if "mathjax" in s.lower()]
+    assert mathjax and all(not s.startswith(("http:", "https:", "//")) for s in mathjax), mathjax
+    local = HTML / "book" / mathjax[0].split("?")[0]
+    assert local.resolve().is_file(), local
+
+
+def test_no_page_loads_anything_from_the_network():
+    remote = re.compile(r'<(?:script|link|img|iframe)[^>]*(?:src|href)="((?:https?:)?//[^"]*)"', re.I)
+    offenders = {}
+    for path in all_pages():
+        found = remote.findall(path.read_text(encoding="utf-8"))
+        if found:
+            offenders[str(path.relative_to(HTML))] = found[:3]
+    assert not offenders, offenders
+
+
+def test_no_page_source_or_notebook_download_ships():
+    assert not (HTML / "_sources").exists()
+    assert not list(HTML.rglob("*.ipynb"))
+    assert "download-source-button" not in page("book/pca")
+
+
+def _code_lines(path):
+    """The code lines of a reference module: no docstrings, comments or imports."""
+    lines, in_docstring = [], False
+    for raw in path.read_text().splitlines():
+        line = raw.strip()
+        quotes = line.count('"""') + line.count("'''")
+        if quotes:
+            in_docstring = in_docstring != (quotes == 1)
+            continue
+        if in_docstring or not line or line.startswith(("#", "import ", "from ")):
+            continue
+        lines.append(" ".join(line.split()))
+    return lines
+
+
+def test_no_reference_code_in_the_built_book():
+    """No run of three consecutive code lines of solutions/ is in any built file."""
+    built = "\n".join(p.read_text(encoding="utf-8", errors="ignore")
+                      for p in HTML.rglob("*") if p.suffix in (".html", ".js", ".txt") and p.is_file())
+    built = html_module.unescape(re.sub(r"<[^>]+>", "", built))  # code is split into highlighted spans
+    built = " ".join(built.split())
+    leaked = []
+    for path in sorted((REPO_ROOT / "solutions").glob("*.py")):
+        lines = _code_lines(path)
+        leaked += [" / ".join(lines[i:i + 3]) for i in range(len(lines) - 2) if " ".join(lines[i:i + 3]) in built]
+    assert not leaked, leaked[:5]

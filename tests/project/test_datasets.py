@@ -1,0 +1,180 @@
+"""The generated data: shapes with exact normals, mini ModelNet, lidar scan, file formats."""
+
+import numpy as np
+import pytest
+
+from pcl_course import datasets
+from pcl_course.io import read_kitti_bin, read_modelnet_txt, write_kitti_bin, write_modelnet_txt
+
+
+@pytest.mark.parametrize("name", datasets.SHAPE_NAMES)
+def test_shape_has_requested_size_and_unit_normals(name):
+    points, normals = datasets.make_shape(name, 1500, rng=0)
+    assert points.shape == normals.shape == (1500, 3)
+    assert points.dtype == normals.dtype == np.float64
+    assert np.allclose(np.linalg.norm(normals, axis=1), 1.0)
+    assert np.all(np.isfinite(points))
+
+
+@pytest.mark.parametrize("name", datasets.SHAPE_NAMES)
+def test_shape_is_deterministic_given_its_seed(name):
+    a = datasets.make_shape(name, 500, noise=0.01, rng=3, variation=0.2)
+    b = datasets.make_shape(name, 500, noise=0.01, rng=3, variation=0.2)
+    c = datasets.make_shape(name, 500, noise=0.01, rng=4, variation=0.2)
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+    assert not np.array_equal(a[0], c[0])
+
+
+def test_there_are_at_least_twelve_categories():
+    assert len(set(datasets.SHAPE_NAMES)) >= 12
+
+
+def test_sphere_normals_are_exact_radial_directions():
+    points, normals = datasets.make_shape("sphere", 2000, rng=1)
+    assert np.allclose(points, normals)  # unit sphere: the point is its normal
+
+
+def test_torus_normals_are_exact():
+    points, normals = datasets.make_shape("torus", 2000, rng=2)
+    major, minor = 0.8, 0.25
+    ring = np.column_stack([points[:, :2], np.zeros(len(points))])
+    centre = major * ring / np.linalg.norm(ring, axis=1, keepdims=True)
+    assert np.allclose(np.linalg.norm(points - centre, axis=1), minor)
+    assert np.allclose(normals, (points - centre) / minor)
+
+
+def test_ellipsoid_points_on_surface_with_gradient_normals():
+    points, normals = datasets.make_shape("ellipsoid", 2000, rng=3)
+    axes = np.array([1.0, 0.6, 0.35])
+    assert np.allclose(np.sum((points / axes) ** 2, axis=1), 1.0)
+    gradient = points / axes**2
+    assert np.allclose(normals, gradient / np.linalg.norm(gradient, axis=1, keepdims=True))
+
+
+def test_cone_normals_are_perpendicular_to_the_slant():
+    points, normals = datasets.make_shape("cone", 4000, rng=4)
+    lateral = normals[:, 2] > -0.99  # not the base disk
+    apex = np.array([0.0, 0.0, 0.6])
+    # On a cone, the line from the apex to the point lies in the surface.
+    along = points[lateral] - apex
+    assert np.allclose(np.sum(along * normals[lateral], axis=1), 0.0, atol=1e-12)
+
+
+def test_sampling_is_uniform_in_area():
+    # Sphere: z is uniform on [-1, 1] (Archimedes). Torus: the density of the
+    # tube angle is proportional to the ring radius.
+    points, _ = datasets.make_shape("sphere", 40000, rng=5)
+    counts, _ = np.histogram(points[:, 2], bins=10, range=(-1, 1))
+    assert np.all(np.abs(counts / 4000 - 1) < 0.06)
+    points, _ = datasets.make_shape("torus", 40000, rng=6)
+    outer = np.mean(np.linalg.norm(points[:, :2], axis=1) > 0.8)
+    expected = 0.5 + 0.25 / (np.pi * 0.8)  # share of the area outside the ring of radius R
+    assert abs(outer - expected) < 0.01
+
+
+def test_box_faces_get_points_in_proportion_to_their_area():
+    points, normals = datasets.make_shape("box", 30000, rng=7)
+    sizes = np.array([1.0, 0.7, 0.5])
+    areas = np.array([sizes[1] * sizes[2], sizes[0] * sizes[2], sizes[0] * sizes[1]])
+    share = np.array([np.mean(np.abs(normals[:, i]) > 0.5) for i in range(3)])
+    assert np.allclose(share, areas / areas.sum(), atol=0.01)
+    # every point lies on the face its normal says
+    face = np.argmax(np.abs(normals), axis=1)
+    assert np.allclose(np.abs(points[np.arange(len(points)), face]), sizes[face] / 2)
+
+
+def test_noise_moves_points_by_its_standard_deviation():
+    clean, _ = datasets.make_shape("plane", 20000, rng=8)
+    noisy, _ = datasets.make_shape("plane", 20000, noise=0.01, rng=8)
+    assert abs(np.std(noisy[:, 2]) - 0.01) < 5e-4
+    assert np.allclose(clean[:, 2], 0.0)
+
+
+def test_make_shape_rejects_bad_arguments():
+    with pytest.raises(ValueError, match="name"):
+        datasets.make_shape("teapot")
+    with pytest.raises(ValueError, match="n_points"):
+        datasets.make_shape("sphere", -1)
+    with pytest.raises(ValueError, match="noise"):
+        datasets.make_shape("sphere", 10, noise=-1.0)
+
+
+def test_modelnet_text_round_trip(tmp_path):
+    points, normals = datasets.make_shape("chair", 300, rng=0)
+    write_modelnet_txt(tmp_path / "chair_0001.txt", points, normals)
+    first = (tmp_path / "chair_0001.txt").read_text().splitlines()[0]
+    assert len(first.split(",")) == 6
+    p, n = read_modelnet_txt(tmp_path / "chair_0001.txt")
+    assert np.allclose(p, points, atol=1e-6) and np.allclose(n, normals, atol=1e-6)
+
+
+def test_mini_modelnet_layout_and_loader(tmp_path):
+    root = datasets.make_mini_modelnet(tmp_path / "mini", n_per_class=3, n_test_per_class=1, n_points=256,
+                                       classes=("chair", "mug"))
+    assert (root / "modelnet40_shape_names.txt").read_text().split() == ["chair", "mug"]
+    assert (root / "chair" / "chair_0003.txt").is_file()
+    train = datasets.load_modelnet(root, "train")
+    test = datasets.load_modelnet(root, "test")
+    assert [o["id"] for o in train] == ["chair_0001", "chair_0002", "mug_0001", "mug_0002"]
+    assert [o["label"] for o in test] == ["chair", "mug"]
+    for obj in train + test:
+        norms = np.linalg.norm(obj["points"] - obj["points"].mean(axis=0), axis=1)
+        assert abs(norms.max() - 1.0) < 1e-5  # unit-sphere scale
+        assert obj["points"].shape == (256, 3)
+    assert not np.allclose(train[0]["points"], train[1]["points"])  # distinct instances
+
+
+def test_kitti_bin_round_trip(tmp_path):
+    rng = np.random.default_rng(0)
+    points, intensity = rng.normal(size=(100, 3)) * 20, rng.uniform(size=100)
+    write_kitti_bin(tmp_path / "000000.bin", points, intensity)
+    assert (tmp_path / "000000.bin").stat().st_size == 100 * 4 * 4
+    scan = read_kitti_bin(tmp_path / "000000.bin")
+    assert scan.dtype == np.float32 and scan.shape == (100, 4)
+    assert np.allclose(scan[:, :3], points, rtol=1e-6) and np.allclose(scan[:, 3], intensity, rtol=1e-6)
+
+
+@pytest.fixture(scope="module")
+def scan():
+    return datasets.simulate_lidar_scan(seed=0)
+
+
+def test_lidar_scan_has_a_realistic_size_and_range(scan):
+    n = len(scan.points)
+    assert 80_000 <= n <= 130_000
+    ranges = np.linalg.norm(scan.points, axis=1)
+    assert ranges.max() <= 100.5 and ranges.max() > 60.0
+    for field in ("intensity", "labels", "ring", "is_outlier"):
+        assert getattr(scan, field).shape == (n,)
+    assert scan.normals.shape == (n, 3)
+    assert np.all((scan.intensity >= 0) & (scan.intensity <= 1))
+
+
+def test_lidar_scan_sees_every_class_and_labels_its_outliers(scan):
+    labels = set(np.unique(scan.labels[~scan.is_outlier]))
+    assert labels == set(range(len(datasets.LIDAR_CLASSES)))
+    assert np.all(scan.labels[scan.is_outlier] == -1)
+    assert 0.001 < scan.is_outlier.mean() < 0.02
+
+
+def test_lidar_ground_points_lie_on_the_ground_plane(scan):
+    ground = scan.labels == datasets.LIDAR_CLASSES.index("ground")
+    assert np.abs(scan.points[ground, 2] + datasets.SENSOR_HEIGHT).max() < 0.2
+    assert np.allclose(scan.normals[ground], [0, 0, 1], atol=1e-6)
+
+
+def test_lidar_normals_face_the_sensor(scan):
+    inliers = ~scan.is_outlier
+    facing = np.sum(scan.normals[inliers] * (scan.origin - scan.points[inliers]), axis=1)
+    assert np.all(facing > 0)
+
+
+def test_lidar_outliers_are_in_front_of_real_surfaces(scan):
+    # A spurious return lies on a beam, closer than where that beam hits.
+    assert np.all(np.linalg.norm(scan.points[scan.is_outlier], axis=1) < 95.0)
+
+
+def test_lidar_scan_is_deterministic():
+    a = datasets.simulate_lidar_scan(seed=1, n_azimuth=360)
+    b = datasets.simulate_lidar_scan(seed=1, n_azimuth=360)
+    assert np.array_equal(a.points, b.points) and np.array_equal(a.labels, b.labels)

@@ -1,0 +1,78 @@
+"""The complete helpers of pcl_course: validation, neighbour search, book picker."""
+
+import numpy as np
+import pytest
+from scipy.spatial.distance import cdist
+
+from pcl_course import book, neighbors, validation
+
+
+def test_as_points_returns_float64_and_accepts_lists():
+    points = validation.as_points([[1, 2, 3], [4, 5, 6]])
+    assert type(points) is np.ndarray and points.dtype == np.float64 and points.shape == (2, 3)
+
+
+@pytest.mark.parametrize("bad, fragment", [
+    (np.zeros(3), "dimension"),
+    (np.zeros((2, 2)), "columns"),
+    ([[1.0, np.nan, 0.0]], "finite"),
+    ([[1.0, 2.0], [3.0]], "numeric"),
+    ("abc", "numeric"),
+])
+def test_as_points_errors_name_the_argument(bad, fragment):
+    with pytest.raises(ValueError, match="cloud") as excinfo:
+        validation.as_points(bad, name="cloud")
+    assert fragment in str(excinfo.value)
+
+
+def test_as_points_converts_subclasses_to_plain_arrays():
+    assert type(validation.as_points(np.ma.masked_array(np.zeros((3, 3))))) is np.ndarray
+
+
+@pytest.mark.parametrize("value", [0, -1.0, np.inf, np.nan, "1", True, None])
+def test_check_positive_rejects(value):
+    with pytest.raises(ValueError, match="radius"):
+        validation.check_positive(value, "radius")
+
+
+def test_check_integer_and_choice_and_rng():
+    assert validation.check_integer(np.int64(3), "k", 1, 5) == 3
+    for bad in (0, 6, 2.5, True):
+        with pytest.raises(ValueError, match="k"):
+            validation.check_integer(bad, "k", 1, 5)
+    with pytest.raises(ValueError, match="method"):
+        validation.check_choice("median", "method", ("centroid", "random"))
+    g = np.random.default_rng(1)
+    assert validation.check_rng(g) is g
+    assert validation.check_rng(5).integers(1000) == np.random.default_rng(5).integers(1000)
+    with pytest.raises(ValueError, match="rng"):
+        validation.check_rng("seed")
+
+
+def test_knn_matches_brute_force_with_and_without_self():
+    rng = np.random.default_rng(0)
+    points = rng.uniform(size=(300, 3))
+    d = cdist(points, points)
+    distances, indices = neighbors.knn(points, 5)
+    assert np.allclose(distances, np.sort(d, axis=1)[:, :5])
+    assert np.all(indices[:, 0] == np.arange(300))
+    distances, indices = neighbors.knn(points, 5, include_self=False)
+    assert not np.any(indices == np.arange(300)[:, None])
+    assert np.allclose(distances, np.sort(d, axis=1)[:, 1:6])
+
+
+def test_knn_without_self_keeps_duplicates():
+    points = np.array([[0.0, 0, 0], [0.0, 0, 0], [1.0, 0, 0]])
+    distances, indices = neighbors.knn(points, 1, include_self=False)
+    assert indices[:, 0].tolist() == [1, 0, 0] or indices[:, 0].tolist() == [1, 0, 1]
+    assert distances[0, 0] == distances[1, 0] == 0.0
+
+
+def test_radius_neighbors_is_inclusive():
+    points = np.array([[0.0, 0, 0], [1.0, 0, 0], [2.5, 0, 0]])
+    result = neighbors.radius_neighbors(points, 1.0)
+    assert [r.tolist() for r in result] == [[0, 1], [0, 1], [2]]
+
+
+def test_book_runs_the_reference_when_it_exists():
+    assert book.implementation("pca").__name__ == "solutions.pca"
