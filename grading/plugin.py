@@ -106,7 +106,13 @@ def _feedback(excinfo, impl):
         expected = text.removeprefix("DID NOT RAISE").strip()
         return f"expected the call to raise {expected}, but it returned normally{last_call}"
     if isinstance(exc, AssertionError):
-        lines = text.splitlines()[:MAX_FEEDBACK_LINES] or ["assertion failed"]
+        lines = text.splitlines()
+        # pytest appends its introspection ("assert ...", "+ where ...") to a
+        # message: the test's own message is the clearer part.
+        cut = next((i for i, line in enumerate(lines) if line.startswith("assert ")), None)
+        if cut:
+            lines = lines[:cut]
+        lines = lines[:MAX_FEEDBACK_LINES] or ["assertion failed"]
         return "\n".join(lines) + last_call
     where = _location_in_implementation(excinfo, impl) if impl else None
     where = f"\n  at {where}" if where else ""
