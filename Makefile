@@ -36,7 +36,7 @@ book: setup $(CODE_STAMP)
 	@echo "The book is in _build/html: open $(CURDIR)/_build/html/index.html"
 
 test: book
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n auto
 
 grade: setup
 	@test -n "$(SUBMISSION)" || { echo "usage: make grade SUBMISSION=path/to/student/clone"; exit 2; }

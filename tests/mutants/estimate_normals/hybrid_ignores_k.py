@@ -1,0 +1,8 @@
+"""With a radius, uses every point within it and ignores k."""
+
+from solutions.normals import *  # noqa: F401,F403
+from solutions.normals import estimate_normals as _reference
+
+
+def estimate_normals(points, k=30, radius=None, viewpoint=None):
+    return _reference(points, None if radius is not None else k, radius, viewpoint)

@@ -1,0 +1,28 @@
+"""One-pass covariance E[p p^T] - mu mu^T: cancels catastrophically far from the origin."""
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from solutions.normals import *  # noqa: F401,F403
+from solutions.normals import estimate_normals as _reference
+
+
+def estimate_normals(points, k=30, radius=None, viewpoint=None):
+    if radius is not None or len(points) == 0:
+        return _reference(points, k, radius, viewpoint)
+    _reference(points, k, radius, viewpoint)  # validation only
+    points = np.asarray(points, dtype=float)
+    _, index = cKDTree(points).query(points, k=k)
+    index = index.reshape(len(points), k)
+    normals, curvature = np.full((len(points), 3), np.nan), np.full(len(points), np.nan)
+    for i, row in enumerate(index):
+        if len(row) < 3:
+            continue
+        nb = points[row]
+        mu = nb.mean(axis=0)
+        values, vectors = np.linalg.eigh(nb.T @ nb / len(nb) - np.outer(mu, mu))
+        normals[i], curvature[i] = vectors[:, 0], max(values[0], 0.0) / values.sum()
+    if viewpoint is not None:
+        flip = np.sum(normals * (np.asarray(viewpoint) - points), axis=1) < 0
+        normals[flip] *= -1
+    return normals, curvature
