@@ -1,30 +1,19 @@
 """The grader grades right: full marks for the reference, zero for the stubs,
 and lost points for every wrong submission in tests/mutants."""
 
-import json
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
+from conftest import run_grader as grade
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT
 
 MUTANTS = sorted((REPO_ROOT / "tests" / "mutants").glob("*/*.py"))
 
 
-def grade(*args, tmp_path):
-    results = tmp_path / "results.json"
-    completed = subprocess.run(
-        [sys.executable, "-m", "grading", "grade", *args, "--results", str(results)],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=900,
-    )
-    assert completed.returncode == 0, completed.stdout + completed.stderr
-    return json.loads(results.read_text()), completed.stdout
-
-
-def test_reference_gets_full_marks(tmp_path):
-    summary, stdout = grade("--reference", tmp_path=tmp_path)
+def test_reference_gets_full_marks(reference_grading):
+    summary, stdout = reference_grading
     failed = [f"{t['name']}: {t['output']}" for t in summary["tests"] if t["status"] != "passed"]
     assert not failed, "the reference loses points:\n" + "\n".join(failed)
     assert summary["score"] == summary["max_score"] > 0
@@ -50,8 +39,8 @@ def test_stubs_get_zero_with_one_not_implemented_line_per_test(tmp_path):
     assert stdout.count("not implemented: ") == len(summary["tests"])
 
 
-def test_every_graded_test_names_its_function(tmp_path):
-    summary, _ = grade("--reference", tmp_path=tmp_path)
+def test_every_graded_test_names_its_function(reference_grading):
+    summary, _ = reference_grading
     for test in summary["tests"]:
         assert any(f"test_{f}_" in test["name"] for f in GRADED_FUNCTIONS), test["name"]
 

@@ -1,0 +1,24 @@
+import json
+import subprocess
+import sys
+
+import pytest
+
+from grading import REPO_ROOT
+
+
+def run_grader(*args, tmp_path):
+    """Run ``python -m grading grade ARGS``; return (results summary, stdout)."""
+    results = tmp_path / "results.json"
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "grade", *args, "--results", str(results)],
+        cwd=REPO_ROOT, capture_output=True, text=True, timeout=900,
+    )
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    return json.loads(results.read_text()), completed.stdout
+
+
+@pytest.fixture(scope="session")
+def reference_grading(tmp_path_factory):
+    """The grader's verdict on the reference solutions, run once per session."""
+    return run_grader("--reference", tmp_path=tmp_path_factory.mktemp("reference"))

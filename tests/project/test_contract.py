@@ -1,0 +1,45 @@
+"""The graded functions follow ../shared/course-api.md, and the book states their points right."""
+
+import re
+import subprocess
+import sys
+
+import pytest
+
+from grading import REPO_ROOT
+
+CHECKER = REPO_ROOT.parent / "shared" / "tools" / "check_api.py"
+
+
+@pytest.mark.skipif(not CHECKER.exists(), reason="../shared/tools/check_api.py is not beside this clone")
+def test_signatures_follow_the_contract():
+    completed = subprocess.run([sys.executable, str(CHECKER)], cwd=REPO_ROOT, capture_output=True, text=True)
+    mismatches = [line for line in completed.stdout.splitlines() if not line.startswith("not written yet")]
+    assert not mismatches, "\n".join(mismatches)
+
+
+def exercises():
+    """(page, stated points, -k expression) of every graded exercise in the book."""
+    found = []
+    for page in sorted((REPO_ROOT / "book").glob("*.md")):
+        for block in re.findall(r":::\{exercise\}(.*?)\n:::", page.read_text(), re.S):
+            points = re.search(r"\*\*(\d+(?:\.\d+)?) points", block)
+            keyword = re.search(r"grading grade \. -k \"?([^\"\n]+)\"?", block)
+            if points and keyword:
+                found.append((page.stem, float(points.group(1)), keyword.group(1).strip()))
+    return found
+
+
+def test_the_book_has_graded_exercises():
+    assert len(exercises()) >= 3
+
+
+@pytest.mark.parametrize("page, points, keyword", exercises())
+def test_book_states_the_points_the_grader_gives(page, points, keyword, reference_grading):
+    summary, _ = reference_grading
+    alternatives = [k.strip() for k in keyword.split(" or ")]
+    selected = [t for t in summary["tests"] if any(k in t["name"] for k in alternatives)]
+    assert selected, f"{page}: -k {keyword!r} selects no graded test"
+    assert sum(t["max_score"] for t in selected) == points, (
+        f"{page} says {points} points for -k {keyword!r}, the grader gives {sum(t['max_score'] for t in selected)}"
+    )
