@@ -1,0 +1,44 @@
+"""Graded tests of ``chamfer_distance`` (``pcl_course/metrics.py``): hand-computed
+cases and a brute-force check with SciPy's pairwise distances."""
+
+import numpy as np
+import pytest
+from scipy.spatial.distance import cdist
+
+
+@pytest.mark.points(2)
+def test_chamfer_distance_hand_computed(impl):
+    a = np.array([[0.0, 0, 0], [1.0, 0, 0]])
+    b = np.array([[0.0, 2.0, 0]])
+    # a -> b: squared distances 4 and 5, mean 4.5; b -> a: nearest is (0,0,0), 4.
+    result = impl.chamfer_distance(a, b)
+    assert isinstance(result, float), f"chamfer_distance must return a Python float, got {type(result).__name__}"
+    assert np.isclose(result, 8.5), (
+        f"expected 4.5 + 4.0 = 8.5, got {result}: mean SQUARED nearest distances, both directions, summed"
+    )
+
+
+@pytest.mark.points(2)
+def test_chamfer_distance_matches_brute_force(impl):
+    rng = np.random.default_rng(41)
+    a, b = rng.normal(size=(300, 3)), rng.normal(size=(200, 3)) + 0.5
+    d = cdist(a, b, "sqeuclidean")
+    expected = d.min(axis=1).mean() + d.min(axis=0).mean()
+    assert np.isclose(impl.chamfer_distance(a, b), expected, rtol=1e-9)
+    assert np.isclose(impl.chamfer_distance(b, a), expected, rtol=1e-9), "the Chamfer distance is symmetric"
+
+
+@pytest.mark.points(1)
+def test_chamfer_distance_of_identical_sets_is_zero(impl):
+    a = np.random.default_rng(42).normal(size=(50, 3))
+    assert impl.chamfer_distance(a, a[::-1]) == pytest.approx(0.0, abs=1e-12)
+
+
+@pytest.mark.points(1)
+def test_chamfer_distance_rejects_bad_input(impl):
+    a = np.zeros((5, 3))
+    with pytest.raises(ValueError) as excinfo:
+        impl.chamfer_distance(a, np.zeros((5, 2)))
+    assert "b" in str(excinfo.value)
+    with pytest.raises(ValueError):
+        impl.chamfer_distance(np.array([[np.nan, 0.0, 0.0]]), a)
