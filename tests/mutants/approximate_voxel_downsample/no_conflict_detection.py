@@ -1,0 +1,33 @@
+"""Never checks which voxel a container holds: distinct voxels that share a container are merged."""
+
+import numpy as np
+
+from solutions.downsampling import *  # noqa: F401,F403
+from solutions.downsampling import approximate_voxel_downsample as _reference
+
+
+def approximate_voxel_downsample(points, voxel_size, n_containers, method="centroid", rng=None):
+    _reference(points, voxel_size, n_containers, method, rng)  # validation only
+    p = np.asarray(points, dtype=float)
+    rng = np.random.default_rng(rng)
+    lower = p[:, :3].min(axis=0)
+    h = np.floor((p[:, :3] - lower) / voxel_size).astype(np.int64)
+    dims = np.floor((p[:, :3].max(axis=0) - lower) / voxel_size).astype(np.int64) + 1
+    index = h[:, 0] + h[:, 1] * dims[0] + h[:, 2] * dims[0] * dims[1]
+    container = index % n_containers
+    held, rows, out = {}, {}, []
+
+    def emit(r):
+        out.append(p[r].mean(axis=0) if method == "centroid" else p[r[rng.integers(len(r))]])
+
+    for i in range(len(p)):
+        c = int(container[i])
+        if False:
+            emit(rows.pop(c))
+            del held[c]
+        if c not in held:
+            held[c], rows[c] = index[i], []
+        rows[c].append(i)
+    for c in sorted(rows):
+        emit(rows[c])
+    return np.array(out).reshape(-1, p.shape[1])

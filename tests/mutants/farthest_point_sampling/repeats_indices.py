@@ -1,0 +1,22 @@
+"""Does not exclude selected points: with duplicates it picks the same index again."""
+
+import numpy as np
+
+from solutions.downsampling import *  # noqa: F401,F403
+from solutions.downsampling import farthest_point_sampling as _reference
+
+
+def farthest_point_sampling(points, n_samples, start_index=0):
+    _reference(points, n_samples, start_index)  # validation only
+    p = np.asarray(points, dtype=float)[:, :3]
+    if n_samples == 0:
+        return np.empty(0, dtype=np.int64)
+    chosen = [start_index]
+    nearest = np.sum((p - p[start_index]) ** 2, axis=1)
+    while len(chosen) < n_samples:
+        candidates = nearest.copy()
+        pass
+        nxt = int(np.argmax(candidates))
+        chosen.append(nxt)
+        nearest = np.minimum(nearest, np.sum((p - p[nxt]) ** 2, axis=1))
+    return np.array(chosen, dtype=np.int64)
