@@ -42,3 +42,29 @@ def test_chamfer_distance_rejects_bad_input(impl):
     assert "b" in str(excinfo.value)
     with pytest.raises(ValueError):
         impl.chamfer_distance(np.array([[np.nan, 0.0, 0.0]]), a)
+
+
+@pytest.mark.points(2)
+def test_depth_metrics_hand_computed(impl):
+    gt = np.array([[2.0, 0.0], [4.0, 5.0]])       # metres; 0 = no ground truth
+    pred = np.array([[2.5, 9.0], [4.0, 4.0]])
+    # Errors at the valid pixels: 0.5, 0, -1 m; inverse errors -0.1, 0, 0.05 1/m.
+    result = impl.depth_metrics(pred, gt)
+    assert isinstance(result, dict) and set(result) >= {"rmse", "mae", "irmse", "imae"}, (
+        "depth_metrics must return a dict with keys rmse, mae, irmse, imae"
+    )
+    expected = {"rmse": 1000 * np.sqrt(1.25 / 3), "mae": 500.0,
+                "irmse": np.sqrt((100.0**2 + 50.0**2) / 3), "imae": 50.0}
+    for key, value in expected.items():
+        assert np.isclose(result[key], value, rtol=1e-9), (
+            f"{key}: expected {value:.4f}, got {result[key]!r}; units: rmse and mae in millimetres, "
+            "irmse and imae in 1/km, over the pixels with gt > 0 only"
+        )
+
+
+@pytest.mark.points(1)
+def test_depth_metrics_of_a_perfect_prediction(impl):
+    gt = np.random.default_rng(43).uniform(1.0, 80.0, size=(20, 30))
+    gt[::3] = 0.0
+    result = impl.depth_metrics(np.where(gt > 0, gt, 7.0), gt)
+    assert all(abs(result[k]) < 1e-9 for k in ("rmse", "mae", "irmse", "imae")), result
