@@ -4,6 +4,8 @@
   ``x,y,z,nx,ny,nz``, comma-separated.
 * KITTI velodyne scans ``.bin``: little-endian float32 records
   ``x, y, z, intensity``.
+* KITTI depth maps (depth completion benchmark) ``.png``: 16-bit grey
+  levels, depth in metres = value / 256, 0 = no measurement.
 """
 
 from pathlib import Path
@@ -12,7 +14,10 @@ import numpy as np
 
 from pcl_course.validation import as_array, as_points
 
-__all__ = ["read_modelnet_txt", "write_modelnet_txt", "read_kitti_bin", "write_kitti_bin"]
+__all__ = [
+    "read_modelnet_txt", "write_modelnet_txt", "read_kitti_bin", "write_kitti_bin",
+    "read_kitti_depth_png", "write_kitti_depth_png",
+]
 
 
 def read_modelnet_txt(path):
@@ -61,3 +66,31 @@ def write_kitti_bin(path, points, intensity):
         raise ValueError(f"intensity must have {points.shape[0]} values, got {intensity.shape[0]}")
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     np.hstack([points, intensity[:, None]]).astype("<f4").tofile(path)
+
+
+def read_kitti_depth_png(path):
+    """Read a KITTI depth PNG (16-bit, depth = value / 256 metres, 0 = missing).
+
+    Returns
+    -------
+    depth : ndarray of float64, shape (H, W)
+        Metres; 0 where there is no measurement.
+    """
+    from PIL import Image
+
+    with Image.open(path) as image:
+        raw = np.array(image, dtype=np.uint32)
+    if raw.ndim != 2 or raw.max(initial=0) > 65535:
+        raise ValueError(f"{path}: not a 16-bit single-channel depth PNG")
+    return raw.astype(np.float64) / 256.0
+
+
+def write_kitti_depth_png(path, depth):
+    """Write a depth map (metres, 0 = missing) as a KITTI 16-bit depth PNG."""
+    from PIL import Image
+
+    depth = as_array(depth, "depth", ndim=2)
+    if depth.min(initial=0) < 0 or depth.max(initial=0) * 256 > 65535:
+        raise ValueError("depth must be in [0, 255.99] metres to fit the 16-bit format")
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    Image.fromarray(np.round(depth * 256.0).astype(np.uint16)).save(path)

@@ -4,7 +4,10 @@ import numpy as np
 import pytest
 
 from pcl_course import datasets
-from pcl_course.io import read_kitti_bin, read_modelnet_txt, write_kitti_bin, write_modelnet_txt
+from pcl_course.io import (
+    read_kitti_bin, read_kitti_depth_png, read_modelnet_txt, write_kitti_bin, write_kitti_depth_png,
+    write_modelnet_txt,
+)
 
 
 @pytest.mark.parametrize("name", datasets.SHAPE_NAMES)
@@ -178,3 +181,16 @@ def test_lidar_scan_is_deterministic():
     a = datasets.simulate_lidar_scan(seed=1, n_azimuth=360)
     b = datasets.simulate_lidar_scan(seed=1, n_azimuth=360)
     assert np.array_equal(a.points, b.points) and np.array_equal(a.labels, b.labels)
+
+
+def test_kitti_depth_png_round_trip(tmp_path):
+    from PIL import Image
+
+    rng = np.random.default_rng(1)
+    depth = np.where(rng.uniform(size=(20, 30)) < 0.3, rng.uniform(1, 80, size=(20, 30)), 0.0)
+    write_kitti_depth_png(tmp_path / "0000000005.png", depth)
+    with Image.open(tmp_path / "0000000005.png") as image:
+        assert np.array(image).dtype == np.uint16  # the devkit's format
+    back = read_kitti_depth_png(tmp_path / "0000000005.png")
+    assert back.shape == depth.shape and np.all((back > 0) == (depth > 0))
+    assert np.abs(back - depth).max() <= 0.5 / 256 + 1e-12
