@@ -69,3 +69,54 @@ def plot_vectors(ax, origins, vectors, length=1.0, color="k", **kwargs):
     return ax.quiver(origins[:, 0], origins[:, 1], origins[:, 2],
                      vectors[:, 0], vectors[:, 1], vectors[:, 2],
                      color=color, arrow_length_ratio=0.15, **kwargs)
+
+
+# --- interactive figures (Plotly) -------------------------------------------
+#
+# The book loads one local copy of plotly.js on the pages that need it (see
+# book/_ext/offline_assets.py), so figures are written without it.
+
+def cloud_trace(points, color=None, size=1.5, name=None, colorscale="Viridis", showscale=False, **marker):
+    """A Plotly 3-D scatter trace of a cloud, coloured by height by default."""
+    import plotly.graph_objects as go
+
+    points = np.asarray(points, dtype=float)
+    color = points[:, 2] if color is None else color
+    return go.Scatter3d(
+        x=points[:, 0], y=points[:, 1], z=points[:, 2], mode="markers", name=name,
+        marker=dict(size=size, color=color, colorscale=colorscale, showscale=showscale, **marker),
+        hoverinfo="skip",
+    )
+
+
+def vectors_trace(origins, vectors, length=1.0, color="black", name=None, width=3):
+    """Line segments from ``origins`` along ``vectors`` (normals, axes), as one trace."""
+    import plotly.graph_objects as go
+
+    origins = np.atleast_2d(np.asarray(origins, dtype=float))
+    ends = origins + np.atleast_2d(vectors) * length
+    segments = np.full((3 * len(origins), 3), np.nan)  # NaN rows break the line between segments
+    segments[0::3], segments[1::3] = origins, ends
+    return go.Scatter3d(x=segments[:, 0], y=segments[:, 1], z=segments[:, 2], mode="lines", name=name,
+                        line=dict(color=color, width=width), hoverinfo="skip")
+
+
+def interactive_figure(traces, title=None, height=520, camera_eye=(1.4, -1.4, 0.9)):
+    """A Plotly figure of 3-D traces with equal axis scales."""
+    import plotly.graph_objects as go
+
+    figure = go.Figure(data=list(traces))
+    figure.update_layout(
+        title=title, height=height, margin=dict(l=0, r=0, t=40 if title else 10, b=0),
+        scene=dict(aspectmode="data", camera=dict(eye=dict(zip("xyz", camera_eye)))),
+        legend=dict(itemsizing="constant"),
+    )
+    return figure
+
+
+def show_interactive(figure):
+    """Display a Plotly figure in the book: an HTML fragment without plotly.js."""
+    from IPython.display import HTML
+
+    return HTML(figure.to_html(full_html=False, include_plotlyjs=False,
+                               config={"displaylogo": False, "responsive": True}))
