@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Install the Debian packages the course needs, or say exactly how to.
 #   libusb-1.0-0 : `import open3d` fails without libusb-1.0.so.0
+#   chromium     : the browser the book's page tests drive (Playwright cannot
+#                  download its own browser here)
 set -euo pipefail
 
 missing=()
 ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0' || missing+=(libusb-1.0-0)
+[ -x /usr/bin/chromium ] || missing+=(chromium)
 
 [ ${#missing[@]} -eq 0 ] && exit 0
 

@@ -101,7 +101,7 @@ def _code_lines(path):
 def test_no_reference_code_in_the_built_book():
     """No run of three consecutive code lines of solutions/ is in any built file."""
     built = "\n".join(p.read_text(encoding="utf-8", errors="ignore")
-                      for p in HTML.rglob("*") if p.suffix in (".html", ".js", ".txt") and p.is_file())
+                      for p in HTML.rglob("*") if p.suffix in (".html", ".js", ".txt", ".py") and p.is_file())
     built = html_module.unescape(re.sub(r"<[^>]+>", "", built))  # code is split into highlighted spans
     built = " ".join(built.split())
     leaked = []
@@ -109,3 +109,42 @@ def test_no_reference_code_in_the_built_book():
         lines = _code_lines(path)
         leaked += [" / ".join(lines[i:i + 3]) for i in range(len(lines) - 2) if " ".join(lines[i:i + 3]) in built]
     assert not leaked, leaked[:5]
+
+
+def test_internal_links_and_anchors_resolve():
+    from urllib.parse import unquote, urlsplit
+
+    broken = []
+    ids_cache = {}
+
+    def ids(path):
+        if path not in ids_cache:
+            ids_cache[path] = set(re.findall(r'\b(?:id|name)="([^"]+)"', path.read_text(encoding="utf-8")))
+        return ids_cache[path]
+
+    for path in all_pages():
+        for href in re.findall(r'<a\s[^>]*href="([^"]*)"', path.read_text(encoding="utf-8")):
+            parts = urlsplit(html_module.unescape(href))
+            if parts.scheme or parts.netloc or href.startswith("mailto:"):
+                continue
+            target = (path.parent / unquote(parts.path)).resolve() if parts.path else path
+            if not target.exists():
+                broken.append(f"{path.relative_to(HTML)}: {href}")
+            elif parts.fragment and target.suffix == ".html" and unquote(parts.fragment) not in ids(target):
+                broken.append(f"{path.relative_to(HTML)}: {href} (no such anchor)")
+    assert not broken, "\n".join(broken[:20])
+
+
+def test_every_graded_exercise_links_its_stub():
+    graded = 0
+    for page_name in toc_files():
+        for block in page(page_name).split('<div class="exercise admonition"')[1:]:
+            block = block.split("</section>")[0]
+            text = html_module.unescape(re.sub(r"<[^>]+>", "", block))
+            if "points" not in text or "grading grade" not in text:
+                continue
+            graded += 1
+            stubs = re.findall(r'href="[^"]*_downloads/[^"]*/(\w+\.py)"', block)
+            assert stubs, f"{page_name}: a graded exercise has no link to its stub"
+            assert all((REPO_ROOT / "pcl_course" / stub).is_file() for stub in stubs)
+    assert graded >= 10, f"found only {graded} graded exercises in the built book"

@@ -1,0 +1,81 @@
+"""The built book in a real browser: headless Chromium (Debian's) driven by
+Playwright, on pages served from localhost. Every page loads without console
+errors, its math is typeset by the local MathJax, its interactive figures
+start (a WebGL canvas each), and a screenshot of each page is kept in
+_build/screenshots/ for a person to look at."""
+
+import functools
+import http.server
+import re
+import shutil
+import threading
+
+import pytest
+
+from grading import REPO_ROOT
+from test_book import HTML, page, toc_files
+
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+SCREENSHOTS = REPO_ROOT / "_build" / "screenshots"
+CHROMIUM_ARGS = [
+    "--headless", "--no-sandbox", "--disable-gpu",
+    # software WebGL, for Plotly's 3-D figures without a GPU
+    "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+    # no calls home: this machine has no network, and the book must not need one
+    "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run",
+]
+
+
+class _QuietHandler(http.server.SimpleHTTPRequestHandler):
+    def log_message(self, *args):
+        pass
+
+
+@pytest.fixture(scope="module")
+def site():
+    page("index")  # fails clearly if the book is not built
+    handler = functools.partial(_QuietHandler, directory=str(HTML))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+    yield f"http://127.0.0.1:{server.server_address[1]}"
+    server.shutdown()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    from playwright.sync_api import sync_playwright
+
+    assert shutil.which(CHROMIUM), "Chromium is missing: `make setup` installs Debian's chromium package"
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield browser
+        browser.close()
+
+
+@pytest.mark.parametrize("name", toc_files())
+def test_page_in_a_real_browser(name, site, browser):
+    html = page(name)
+    tab = browser.new_page(viewport={"width": 1280, "height": 900})
+    errors, remote = [], []
+    tab.on("console", lambda message: errors.append(message.text) if message.type == "error" else None)
+    tab.on("pageerror", lambda error: errors.append(str(error)))
+    tab.on("request", lambda request: remote.append(request.url)
+           if not request.url.startswith((site, "data:", "blob:")) else None)
+    tab.goto(f"{site}/{name}.html", wait_until="load")
+
+    if 'class="math' in html:
+        tab.wait_for_function("window.MathJax && MathJax.startup && MathJax.startup.promise", timeout=20000)
+        tab.evaluate("MathJax.startup.promise")
+        assert tab.locator("mjx-container").count() > 0, f"{name}: math was not typeset"
+
+    figures = html.count('class="plotly-graph-div"')
+    if figures:
+        tab.wait_for_function(
+            f"document.querySelectorAll('.js-plotly-plot canvas').length >= {figures}", timeout=30000)
+        assert tab.locator(".js-plotly-plot").count() == figures, f"{name}: not every Plotly figure started"
+
+    SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+    tab.screenshot(path=str(SCREENSHOTS / (re.sub(r"\W", "_", name) + ".png")))
+    tab.close()
+    assert not errors, f"{name}: console errors {errors}"
+    assert not remote, f"{name}: requests off this machine {remote[:3]}"
