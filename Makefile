@@ -9,7 +9,7 @@ STAMP  := $(VENV)/.setup-done
 SUBMISSION ?=
 RESULTS ?= results/results.json
 
-.PHONY: setup book test grade requirements clean
+.PHONY: setup book notebooks test grade requirements clean
 
 setup: $(STAMP)
 
@@ -35,8 +35,17 @@ book: setup $(CODE_STAMP)
 	$(BIN)/jupyter-book build . -W -n --keep-going
 	@echo "The book is in _build/html: open $(CURDIR)/_build/html/index.html"
 
-test: book
+# The chapters as .ipynb (jupytext), for nbval: it runs every cell again,
+# independently of the book's execution cache.
+notebooks: setup
+	rm -rf _build/notebooks && mkdir -p _build/notebooks
+	for page in $$(grep -l '{code-cell}' book/*.md); do \
+	    $(BIN)/jupytext --quiet --to ipynb --output _build/notebooks/$$(basename $$page .md).ipynb $$page || exit 1; \
+	done
+
+test: book notebooks
 	$(BIN)/python -m pytest -n auto
+	$(BIN)/python -m pytest -n auto --dist loadfile --nbval-lax _build/notebooks
 
 grade: setup
 	@test -n "$(SUBMISSION)" || { echo "usage: make grade SUBMISSION=path/to/student/clone"; exit 2; }
