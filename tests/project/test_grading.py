@@ -9,9 +9,6 @@ from conftest import run_grader as grade
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT
 
-MUTANTS = sorted((REPO_ROOT / "tests" / "mutants").glob("*/*.py"))
-
-
 def test_reference_gets_full_marks(reference_grading):
     summary, stdout = reference_grading
     failed = [f"{t['name']}: {t['output']}" for t in summary["tests"] if t["status"] != "passed"]
@@ -56,26 +53,41 @@ def test_no_matching_test_is_a_usage_error():
     assert completed.returncode == 2 and "no graded test matches" in completed.stderr
 
 
-@pytest.mark.parametrize("mutant", MUTANTS, ids=[f"{m.parent.name}/{m.stem}" for m in MUTANTS])
-def test_wrong_submission_loses_points(mutant, tmp_path):
-    function = mutant.parent.name
-    module = GRADED_FUNCTIONS[function]
-    summary, _ = grade("--reference", "--impl-module", f"{module}={mutant}", "-k", f"test_{function}_",
-                       tmp_path=tmp_path)
+def grade_one_function(module_file, tmp_path):
+    """Grade ``tests/<kind>/<function>/<name>.py`` as that function's module,
+    the reference standing in for the rest, with that function's tests only."""
+    function = module_file.parent.name
+    assert function in GRADED_FUNCTIONS, f"{module_file}: its folder must be named after a graded function"
+    summary, _ = grade("--reference", "--impl-module", f"{GRADED_FUNCTIONS[function]}={module_file}",
+                       "-k", f"test_{function}_", tmp_path=tmp_path)
     assert summary["tests"], f"no test of {function} ran"
+    return summary
+
+
+def ids(files):
+    return [f"{path.parent.name}/{path.stem}" for path in files]
+
+
+MUTANTS = sorted((REPO_ROOT / "tests" / "mutants").glob("*/*.py"))
+ALTERNATIVES = sorted((REPO_ROOT / "tests" / "alternatives").glob("*/*.py"))
+
+
+@pytest.mark.parametrize("mutant", MUTANTS, ids=ids(MUTANTS))
+def test_wrong_submission_loses_points(mutant, tmp_path):
+    summary = grade_one_function(mutant, tmp_path)
     assert summary["score"] < summary["max_score"], (
         f"{mutant.relative_to(REPO_ROOT)} ({mutant.read_text().splitlines()[0]}) keeps full marks"
     )
 
 
-ALTERNATIVES = sorted((REPO_ROOT / "tests" / "alternatives").glob("*/*.py"))
-
-
-@pytest.mark.parametrize("variant", ALTERNATIVES, ids=[f"{m.parent.name}/{m.stem}" for m in ALTERNATIVES])
+@pytest.mark.parametrize("variant", ALTERNATIVES, ids=ids(ALTERNATIVES))
 def test_other_correct_submission_gets_full_marks(variant, tmp_path):
-    function = variant.parent.name
-    module = GRADED_FUNCTIONS[function]
-    summary, _ = grade("--reference", "--impl-module", f"{module}={variant}", "-k", f"test_{function}_",
-                       tmp_path=tmp_path)
+    summary = grade_one_function(variant, tmp_path)
     failed = [f"{t['name']}: {t['output']}" for t in summary["tests"] if t["status"] != "passed"]
-    assert summary["tests"] and not failed, f"{variant.name} loses points:\n" + "\n".join(failed)
+    assert not failed, f"{variant.name} loses points:\n" + "\n".join(failed)
+
+
+def test_every_graded_function_has_wrong_and_alternative_submissions():
+    for kind, files in (("mutants", MUTANTS), ("alternatives", ALTERNATIVES)):
+        missing = set(GRADED_FUNCTIONS) - {path.parent.name for path in files}
+        assert not missing, f"tests/{kind} has nothing for {sorted(missing)}"
