@@ -11,19 +11,25 @@ Grade the reference solutions, or only the ``pca`` tests::
     python -m grading grade --reference
     python -m grading grade . -k pca
 
+Grade a whole class, one submission per subdirectory, in parallel::
+
+    python -m grading batch submissions/ --csv marks.csv
+
 The exit status is 0 whenever grading ran, whatever the score; 2 for a usage
 error (no ``pcl_course/`` found, no test selected); 1 if pytest itself broke.
 """
 
 import argparse
+import csv
 import json
 import os
 import subprocess
 import sys
 import tempfile
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from grading import GRADED_TESTS, REPO_ROOT
+from grading import GRADED_FUNCTIONS, GRADED_TESTS, REPO_ROOT
 
 PYTEST_EXIT_NO_TESTS = 5
 
@@ -101,6 +107,57 @@ def grade(args):
 
 
 
+def points_per_function(summary):
+    """Score and maximum per graded function, from a results summary."""
+    totals = {}
+    for test in summary["tests"]:
+        function = next((f for f in sorted(GRADED_FUNCTIONS, key=len, reverse=True)
+                         if test["name"].startswith(f"test_{f}_")), "other")
+        score, maximum = totals.get(function, (0.0, 0.0))
+        totals[function] = (score + test["score"], maximum + test["max_score"])
+    return totals
+
+
+def batch(args):
+    root = Path(args.directory).resolve()
+    submissions = sorted(p for p in root.iterdir() if (p / "pcl_course" / "__init__.py").is_file())
+    if not submissions:
+        raise SystemExit(f"error: no subdirectory of {root} holds a pcl_course/ package")
+    out = Path(args.out).resolve() if args.out else root.parent / f"{root.name}-results"
+    out.mkdir(parents=True, exist_ok=True)
+
+    def grade_one(submission):
+        results = out / f"{submission.name}.json"
+        code, output = run_graded_tests(submission / "pcl_course", results, args.k)
+        if code not in (0, 1) or not results.exists():
+            return submission.name, None, output
+        return submission.name, json.loads(results.read_text()), output
+
+    # Each grading is its own pytest process: threads only wait for them.
+    with ThreadPoolExecutor(max_workers=args.jobs or os.cpu_count() or 1) as pool:
+        graded = list(pool.map(grade_one, submissions))
+
+    functions = [f for f in GRADED_FUNCTIONS if any(r and f in points_per_function(r) for _, r, _ in graded)]
+    csv_path = Path(args.csv) if args.csv else out / "marks.csv"
+    with open(csv_path, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(["submission", "score", "max_score", "status", *functions])
+        for name, summary, _ in graded:
+            if summary is None:
+                writer.writerow([name, 0, "", "grading failed", *[""] * len(functions)])
+                continue
+            per_function = points_per_function(summary)
+            writer.writerow([name, f"{summary['score']:g}", f"{summary['max_score']:g}", "graded",
+                             *[f"{per_function.get(f, (0, 0))[0]:g}" for f in functions]])
+    for name, summary, output in graded:
+        mark = f"{summary['score']:g} / {summary['max_score']:g}" if summary else "grading failed"
+        print(f"{name}: {mark}")
+        if summary is None:
+            print(output, file=sys.stderr)
+    print(f"Marks written to {csv_path}; results files in {out}")
+    return 0
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m grading", description=__doc__.split("\n")[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -112,7 +169,15 @@ def main(argv=None):
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
     g.add_argument("--impl-module", action="append", default=[], metavar="MODULE=FILE",
                    help=argparse.SUPPRESS)  # mutation checks: replace one module
+    b = commands.add_parser("batch", help="grade every submission in a folder, in parallel")
+    b.add_argument("directory", help="a folder with one student clone (holding pcl_course/) per subdirectory")
+    b.add_argument("--csv", help="where to write the marks (default: OUT/marks.csv)")
+    b.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
+    b.add_argument("--jobs", type=int, help="submissions graded at once (default: number of cores)")
+    b.add_argument("-k", help="select tests as pytest -k does")
     args = parser.parse_args(argv)
     if args.command == "grade":
         return grade(args)
+    if args.command == "batch":
+        return batch(args)
     return 2

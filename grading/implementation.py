@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from grading import GRADED_FUNCTIONS
+from grading import GRADED_FUNCTIONS, REPO_ROOT
+from grading.forbidden import scan_package
 
 _counter = itertools.count()
 
@@ -28,6 +29,17 @@ class NotImplementedYet(Exception):
 
 class StudentError(Exception):
     """The implementation under test raised an unexpected exception."""
+
+
+class ForbiddenAPI(Exception):
+    """An exercise module uses (or imports a module that uses) a forbidden API."""
+
+    def __init__(self, module, violations):
+        shown = "; ".join(str(v) for v in violations[:3])
+        super().__init__(
+            f"forbidden API in {module}.py ({shown}): write your own code; Open3D, PCL and "
+            "scikit-learn are allowed for visualisation only, outside the exercise modules"
+        )
 
 
 def describe(value):
@@ -69,6 +81,8 @@ class Implementation:
         self.package = f"_graded_impl_{next(_counter)}"
         self._modules = {}
         self.last_call = None
+        # Read before anything runs: a forbidden import costs the module's points.
+        self.violations = scan_package(self.directory, REPO_ROOT / "pcl_course", self.overrides)
         self._make_package()
 
     def _make_package(self):
@@ -99,7 +113,10 @@ class Implementation:
     def __getattr__(self, name):
         if name not in GRADED_FUNCTIONS:
             raise AttributeError(name)
-        function = getattr(self.module(GRADED_FUNCTIONS[name]), name, None)
+        module_name = GRADED_FUNCTIONS[name]
+        if self.violations.get(module_name):
+            raise ForbiddenAPI(module_name, self.violations[module_name])
+        function = getattr(self.module(module_name), name, None)
         if function is None:
             raise StudentError(f"{GRADED_FUNCTIONS[name]}.py defines no function {name}")
 

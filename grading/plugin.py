@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 
-from grading.implementation import Implementation, NotImplementedYet
+from grading.implementation import ForbiddenAPI, Implementation, NotImplementedYet
 
 DEFAULT_TIMEOUT = 60.0  # seconds per graded test, ample for plain-loop solutions
 MAX_FEEDBACK_LINES = 12
@@ -97,7 +97,7 @@ def _feedback(excinfo, impl):
     """One short, readable explanation of a failure."""
     exc = excinfo.value
     last_call = f"\n  last call: {impl.last_call}" if impl and impl.last_call else ""
-    if isinstance(exc, NotImplementedYet):
+    if isinstance(exc, (NotImplementedYet, ForbiddenAPI)):
         return str(exc)
     text = str(exc).strip()
     if excinfo.typename == "Failed" and text.startswith("Timeout"):
@@ -142,7 +142,7 @@ def pytest_runtest_makereport(item, call):
         if report.when != "call":
             message = f"error in test {report.when}: {message}"
         entry.update(score=0.0, status="failed", output=message)
-        if isinstance(call.excinfo.value if call.excinfo else None, NotImplementedYet):
+        if isinstance(call.excinfo.value if call.excinfo else None, (NotImplementedYet, ForbiddenAPI)):
             report.longrepr = message  # one line, not a traceback
     elif report.skipped and report.when != "teardown":
         entry.update(score=0.0, status="failed", output="skipped")

@@ -1,0 +1,38 @@
+"""Batch mode: a folder of submissions graded in parallel, marks in a CSV."""
+
+import csv
+import shutil
+import subprocess
+import sys
+
+from grading import REPO_ROOT
+
+
+def make_submission(root, name, exercises_from):
+    package = root / name / "pcl_course"
+    shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
+    for module in exercises_from:
+        shutil.copy(module, package / module.name)
+    return package
+
+
+def test_batch_grades_every_submission_and_writes_a_csv(tmp_path):
+    classroom = tmp_path / "class"
+    make_submission(classroom, "alice", [REPO_ROOT / "solutions" / "metrics.py"])  # right
+    make_submission(classroom, "bob", [])                                         # stubs
+    carol = make_submission(classroom, "carol", [REPO_ROOT / "solutions" / "metrics.py"])
+    (carol / "metrics.py").write_text((carol / "metrics.py").read_text().replace(
+        "np.mean(a_to_b**2) + np.mean(b_to_a**2)", "np.mean(a_to_b) + np.mean(b_to_a)"))  # unsquared
+    (classroom / "notes.txt").write_text("not a submission")
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "batch", str(classroom), "--csv", str(tmp_path / "marks.csv"),
+         "--jobs", "2", "-k", "test_chamfer_distance_ or test_depth_metrics_"],
+        cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    rows = {row["submission"]: row for row in csv.DictReader(open(tmp_path / "marks.csv"))}
+    assert set(rows) == {"alice", "bob", "carol"}
+    assert rows["alice"]["score"] == rows["alice"]["max_score"] == "9"
+    assert rows["bob"]["score"] == "0"
+    assert rows["carol"]["chamfer_distance"] != rows["alice"]["chamfer_distance"]
+    assert rows["carol"]["depth_metrics"] == "3"
+    assert (tmp_path / "class-results" / "alice.json").is_file()
