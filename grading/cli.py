@@ -43,7 +43,8 @@ def find_package(submission):
     raise SystemExit(f"error: no pcl_course/ package found in {submission}")
 
 
-def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), tests=None):
+def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), tests=None, sandbox=False,
+                     call_timeout=None):
     """Run the graded tests on ``impl_dir``; return pytest's exit code."""
     command = [
         sys.executable, "-m", "pytest", str(tests or GRADED_TESTS),
@@ -56,6 +57,10 @@ def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), 
     ]
     for override in overrides:
         command += ["--impl-module", override]
+    if sandbox:
+        command.append("--sandbox")
+    if call_timeout:
+        command += ["--call-timeout", str(call_timeout)]
     if keyword:
         command += ["-k", keyword]
     if junit:
@@ -90,7 +95,11 @@ def grade(args):
     else:
         raise SystemExit("error: give a SUBMISSION directory or --reference")
     results = Path(args.results) if args.results else Path(tempfile.mkdtemp()) / "results.json"
-    code, output = run_graded_tests(impl_dir, results, args.k, args.junit, args.impl_module)
+    # The reference and the project's own wrong submissions are trusted code;
+    # a student's submission runs in the sandbox.
+    sandbox = not args.reference and not args.impl_module
+    code, output = run_graded_tests(impl_dir, results, args.k, args.junit, args.impl_module, sandbox=sandbox,
+                                    call_timeout=args.call_timeout)
     if code == PYTEST_EXIT_NO_TESTS:
         print(f"error: no graded test matches -k {args.k!r}", file=sys.stderr)
         return 2
@@ -128,7 +137,7 @@ def batch(args):
 
     def grade_one(submission):
         results = out / f"{submission.name}.json"
-        code, output = run_graded_tests(submission / "pcl_course", results, args.k)
+        code, output = run_graded_tests(submission / "pcl_course", results, args.k, sandbox=True)
         if code not in (0, 1) or not results.exists():
             return submission.name, None, output
         return submission.name, json.loads(results.read_text()), output
@@ -167,6 +176,7 @@ def main(argv=None):
     g.add_argument("--results", help="write the Gradescope results JSON here")
     g.add_argument("--junit", help="also write JUnit XML here")
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
+    g.add_argument("--call-timeout", type=float, help="seconds one call of a submission may take (default 30)")
     g.add_argument("--impl-module", action="append", default=[], metavar="MODULE=FILE",
                    help=argparse.SUPPRESS)  # mutation checks: replace one module
     b = commands.add_parser("batch", help="grade every submission in a folder, in parallel")

@@ -75,7 +75,7 @@ class Implementation:
         module of a wrong submission against the reference for the rest).
     """
 
-    def __init__(self, directory, overrides=None):
+    def __init__(self, directory, overrides=None, sandbox=False, call_timeout=30.0):
         self.directory = Path(directory).resolve()
         self.overrides = {k: Path(v).resolve() for k, v in (overrides or {}).items()}
         self.package = f"_graded_impl_{next(_counter)}"
@@ -83,7 +83,16 @@ class Implementation:
         self.last_call = None
         # Read before anything runs: a forbidden import costs the module's points.
         self.violations = scan_package(self.directory, REPO_ROOT / "pcl_course", self.overrides)
-        self._make_package()
+        self.worker = None
+        if sandbox:
+            # The submission runs in a worker process, never in this one.
+            from grading.sandbox import Worker
+
+            if self.overrides or self.directory.name != "pcl_course":
+                raise ValueError("the sandbox grades a clone's pcl_course/ package, without overrides")
+            self.worker = Worker(self.directory.parent, timeout=call_timeout)
+        else:
+            self._make_package()
 
     def _make_package(self):
         init = self.directory / "__init__.py"
@@ -116,9 +125,16 @@ class Implementation:
         module_name = GRADED_FUNCTIONS[name]
         if self.violations.get(module_name):
             raise ForbiddenAPI(module_name, self.violations[module_name])
-        function = getattr(self.module(module_name), name, None)
-        if function is None:
-            raise StudentError(f"{GRADED_FUNCTIONS[name]}.py defines no function {name}")
+        if self.worker is not None:
+            if not (self.directory / f"{module_name}.py").is_file():
+                raise StudentError(f"the submission has no module {module_name}.py")
+
+            def function(*args, **kwargs):
+                return self.worker.call(module_name, name, args, kwargs)
+        else:
+            function = getattr(self.module(module_name), name, None)
+            if function is None:
+                raise StudentError(f"{GRADED_FUNCTIONS[name]}.py defines no function {name}")
 
         def graded_call(*args, **kwargs):
             self.last_call = describe_call(name, args, kwargs)
@@ -129,3 +145,7 @@ class Implementation:
 
         graded_call.__name__ = name
         return graded_call
+
+    def close(self):
+        if self.worker is not None:
+            self.worker.stop()

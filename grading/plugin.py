@@ -42,6 +42,10 @@ def pytest_addoption(parser):
                     help="replace one exercise module of --impl by FILE")
     group.addoption("--results", default=None, metavar="FILE",
                     help="write the results (Gradescope JSON) to FILE")
+    group.addoption("--sandbox", action="store_true",
+                    help="run the implementation in a limited worker process (grading/sandbox.py)")
+    group.addoption("--call-timeout", type=float, default=30.0, metavar="SECONDS",
+                    help="wall-clock limit of one call in the sandbox (default 30)")
 
 
 def pytest_configure(config):
@@ -59,7 +63,8 @@ def _implementation(config):
             if not sep:
                 raise pytest.UsageError(f"--impl-module takes MODULE=FILE, got {item!r}")
             overrides[module] = path
-        config.stash[_IMPL_KEY] = Implementation(directory, overrides)
+        config.stash[_IMPL_KEY] = Implementation(directory, overrides, sandbox=config.getoption("--sandbox"),
+                                                 call_timeout=config.getoption("--call-timeout"))
     return config.stash[_IMPL_KEY]
 
 
@@ -100,6 +105,8 @@ def _feedback(excinfo, impl):
     if isinstance(exc, (NotImplementedYet, ForbiddenAPI)):
         return str(exc)
     text = str(exc).strip()
+    if type(exc).__name__ == "SandboxError":
+        return f"{text}{last_call}"
     if excinfo.typename == "Failed" and text.startswith("Timeout"):
         return f"timed out: {text.splitlines()[0]}{last_call}"
     if excinfo.typename == "Failed" and text.startswith("DID NOT RAISE"):
@@ -114,7 +121,7 @@ def _feedback(excinfo, impl):
             lines = lines[:cut]
         lines = lines[:MAX_FEEDBACK_LINES] or ["assertion failed"]
         return "\n".join(lines) + last_call
-    where = _location_in_implementation(excinfo, impl) if impl else None
+    where = getattr(exc, "where", None) or (_location_in_implementation(excinfo, impl) if impl else None)
     where = f"\n  at {where}" if where else ""
     first = text.splitlines()[0] if text else ""
     return f"raised {excinfo.typename}: {first}{where}{last_call}"
@@ -155,6 +162,12 @@ def results_summary(results):
         "max_score": sum(t["max_score"] for t in tests),
         "tests": tests,
     }
+
+
+def pytest_unconfigure(config):
+    impl = config.stash.get(_IMPL_KEY, None)
+    if impl is not None:
+        impl.close()
 
 
 def pytest_sessionfinish(session, exitstatus):

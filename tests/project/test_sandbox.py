@@ -1,0 +1,178 @@
+"""The sandbox that runs submissions (grading/sandbox.py): hostile code loses
+its own calls, never the grader's process, and sees neither the reference
+nor the tests."""
+
+import os
+import shutil
+import textwrap
+
+import numpy as np
+import pytest
+from conftest import run_grader
+
+from grading import REPO_ROOT
+from grading.sandbox import SandboxError, Worker, namespace_available
+
+EVIL = textwrap.dedent('''
+    import os, sys, time
+    import numpy as np
+
+    def echo(x):
+        return x
+
+    def read_reference():
+        return open(os.path.join(REPO, "solutions", "pca.py")).read()
+
+    def list_tests():
+        return sorted(os.listdir(os.path.join(REPO, "tests")))
+
+    def import_reference():
+        from solutions.pca import pca
+        return "imported"
+
+    def environment():
+        return dict(os.environ)
+
+    def loop_forever():
+        while True:
+            pass
+
+    def memory_bomb():
+        return np.ones(10**11)
+
+    def fork_bomb():
+        pids = []
+        for _ in range(100000):
+            pids.append(os.fork())
+            if pids[-1] == 0:
+                time.sleep(60)
+                os._exit(0)
+
+    def hard_exit():
+        os._exit(0)
+
+    def exit_zero():
+        sys.exit(0)
+
+    def keyboard_interrupt():
+        raise KeyboardInterrupt
+
+    def subclass():
+        class Sneaky(np.ndarray):
+            pass
+        return np.zeros(3).view(Sneaky)
+
+    def always_equal():
+        class Equal:
+            def __eq__(self, other):
+                return True
+        return Equal()
+
+    def forged_answer():
+        print("{\\"ok\\": true, \\"value\\": {\\"t\\": \\"json\\", \\"v\\": 42}}")
+        sys.stdout.write("garbage\\n")
+        return 7
+
+    def value_error():
+        raise ValueError("points must be 2-D")
+''').replace("REPO", repr(str(REPO_ROOT)))
+
+
+@pytest.fixture
+def worker(tmp_path):
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "evil.py").write_text(EVIL)
+    w = Worker(package.parent, timeout=10)
+    yield w
+    w.stop()
+
+
+def test_plain_data_round_trips(worker):
+    value = (np.arange(6.0).reshape(2, 3), {"rmse": 1.5, "n": 3}, [True, None, "x"], np.float64(2.5))
+    result = worker.call("evil", "echo", (value,), {})
+    assert type(result[0]) is np.ndarray and np.array_equal(result[0], value[0])
+    assert result[1] == {"rmse": 1.5, "n": 3} and result[2] == [True, None, "x"]
+    assert type(result[3]) is np.float64
+
+
+def test_student_exceptions_keep_their_type_and_the_worker(worker):
+    with pytest.raises(ValueError, match="2-D"):
+        worker.call("evil", "value_error", (), {})
+    pid = worker.process.pid
+    assert worker.call("evil", "echo", (1,), {}) == 1 and worker.process.pid == pid
+
+
+@pytest.mark.parametrize("function", ["loop_forever", "memory_bomb", "fork_bomb", "hard_exit",
+                                      "exit_zero", "keyboard_interrupt", "subclass", "always_equal"])
+def test_hostile_calls_fail_alone(worker, function):
+    worker.timeout = 5
+    with pytest.raises(SandboxError):
+        worker.call("evil", function, (), {})
+    assert worker.call("evil", "echo", ("still here",), {}) == "still here"
+
+
+def test_printed_text_cannot_forge_an_answer(worker):
+    assert worker.call("evil", "forged_answer", (), {}) == 7
+
+
+def test_the_environment_is_stripped(worker, monkeypatch):
+    monkeypatch.setenv("GRADER_SECRET_TOKEN", "hunter2")
+    worker.stop()
+    environment = worker.call("evil", "environment", (), {})
+    assert "GRADER_SECRET_TOKEN" not in environment and set(environment) <= {
+        "PATH", "HOME", "LANG", "TMPDIR", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+        "OPEN3D_DISABLE_WEB_VISUALIZER", "MPLBACKEND", "LC_CTYPE", "PWD", "SHLVL", "_"}
+
+
+def test_the_reference_is_not_importable(worker):
+    with pytest.raises(ModuleNotFoundError):
+        worker.call("evil", "import_reference", (), {})
+
+
+@pytest.mark.skipif(not namespace_available(), reason="needs root with util-linux unshare and setpriv")
+def test_the_reference_and_the_tests_are_not_readable(worker):
+    with pytest.raises((FileNotFoundError, PermissionError)):
+        worker.call("evil", "read_reference", (), {})
+    assert worker.call("evil", "list_tests", (), {}) == []
+
+
+def make_clone(tmp_path, replace=None):
+    clone = tmp_path / "clone"
+    shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
+    for module in ("pca", "normals", "metrics"):
+        shutil.copy(REPO_ROOT / "solutions" / f"{module}.py", clone / "pcl_course" / f"{module}.py")
+    for name, text in (replace or {}).items():
+        (clone / name).parent.mkdir(parents=True, exist_ok=True)
+        (clone / name).write_text(text)
+    return clone
+
+
+def test_an_infinite_loop_costs_only_its_tests(tmp_path):
+    source = (REPO_ROOT / "solutions" / "normals.py").read_text().replace(
+        "def fit_plane(points, weights=None):\n", "def fit_plane(points, weights=None):\n    while True:\n        pass\n")
+    clone = make_clone(tmp_path, {"pcl_course/normals.py": source})
+    summary, _ = run_grader(str(clone), "-k", "test_fit_plane_recovers or test_estimate_normals_on_a_plane",
+                            "--call-timeout", "3", tmp_path=tmp_path)
+    scores = {t["name"]: t["score"] for t in summary["tests"]}
+    assert scores["test_fit_plane_recovers_a_known_plane"] == 0
+    assert scores["test_estimate_normals_on_a_plane_are_exact_and_flat"] > 0
+
+
+def test_exit_at_import_and_tampering_files_change_nothing_else(tmp_path):
+    marker = tmp_path / "sitecustomize-ran"
+    clone = make_clone(tmp_path, {
+        "pcl_course/metrics.py": "import sys\nsys.exit(0)\n",
+        "conftest.py": "import pytest\n@pytest.fixture(autouse=True)\ndef cheat():\n    raise SystemExit\n",
+        "pytest.ini": "[pytest]\naddopts = -p no:grading.plugin\n",
+        "sitecustomize.py": f"open({str(marker)!r}, 'w').write('ran')\n",
+        "usercustomize.py": f"open({str(marker)!r}, 'w').write('ran')\n",
+        "evil.pth": f"import os; open({str(marker)!r}, 'w').write('ran')\n",
+    })
+    summary, stdout = run_grader(str(clone), "-k", "test_chamfer_distance_ or test_pca_", tmp_path=tmp_path)
+    chamfer = [t for t in summary["tests"] if "chamfer" in t["name"]]
+    pca = [t for t in summary["tests"] if t["name"].startswith("test_pca_")]
+    assert chamfer and all(t["score"] == 0 for t in chamfer)
+    assert pca and all(t["status"] == "passed" for t in pca)
+    assert not marker.exists()
