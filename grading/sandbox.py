@@ -44,6 +44,7 @@ CPU_LIMIT = 600                 # CPU seconds for a worker's whole life
 PROCESS_LIMIT = 256             # processes of the unprivileged user (fork bombs)
 NOBODY = 65534
 HIDDEN_FROM_SUBMISSIONS = ("solutions", "tests")
+FORBIDDEN_PACKAGES = ("open3d", "sklearn", "torch", "fpsample")  # installed ones are hidden in the namespace
 
 
 class SandboxError(Exception):
@@ -85,6 +86,18 @@ def _group_members(pgid):
     return members
 
 
+def _installed_packages(names):
+    """Directories of the installed packages ``names`` (without importing them)."""
+    import importlib.util
+
+    found = []
+    for name in names:
+        spec = importlib.util.find_spec(name)
+        if spec is not None and spec.submodule_search_locations:
+            found.extend(Path(p) for p in spec.submodule_search_locations)
+    return found
+
+
 def namespace_available():
     return os.geteuid() == 0 and bool(shutil.which("unshare")) and bool(shutil.which("setpriv"))
 
@@ -104,8 +117,9 @@ class Worker:
         python = [sys.executable, "-I", str(WORKER), clone, nonce, work]
         if not self.isolated:
             return python
-        mounts = " && ".join(f"mount -t tmpfs -o size=64k,mode=0755 none {REPO_ROOT / d}"
-                             for d in HIDDEN_FROM_SUBMISSIONS if (REPO_ROOT / d).is_dir())
+        hidden = [REPO_ROOT / d for d in HIDDEN_FROM_SUBMISSIONS if (REPO_ROOT / d).is_dir()]
+        hidden += [p for p in _installed_packages(FORBIDDEN_PACKAGES)]
+        mounts = " && ".join(f"mount -t tmpfs -o size=64k,mode=0755 none '{path}'" for path in hidden)
         drop = ["setpriv", f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups", "--"]
         script = f"{mounts} && exec \"$@\"" if mounts else "exec \"$@\""
         return ["unshare", "--mount", "--propagation", "private", "--fork", "--",

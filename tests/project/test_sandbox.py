@@ -73,6 +73,16 @@ EVIL = textwrap.dedent('''
         sys.stdout.write("garbage\\n")
         return 7
 
+    def import_open3d():
+        import open3d
+        return "imported"
+
+    def import_sklearn_around_the_blocker():
+        import sys
+        sys.meta_path[:] = [f for f in sys.meta_path if type(f).__name__ != "_ForbiddenImports"]
+        from sklearn.decomposition import PCA  # an empty directory stands where sklearn was
+        return "imported"
+
     def value_error():
         raise ValueError("points must be 2-D")
 ''').replace("REPO", repr(str(REPO_ROOT)))
@@ -124,6 +134,17 @@ def test_the_environment_is_stripped(worker, monkeypatch):
     assert "GRADER_SECRET_TOKEN" not in environment and set(environment) <= {
         "PATH", "HOME", "LANG", "TMPDIR", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
         "OPEN3D_DISABLE_WEB_VISUALIZER", "MPLBACKEND", "LC_CTYPE", "PWD", "SHLVL", "_"}
+
+
+def test_forbidden_packages_cannot_be_imported_at_run_time(worker):
+    with pytest.raises(ImportError, match="not available to submissions"):
+        worker.call("evil", "import_open3d", (), {})
+
+
+@pytest.mark.skipif(not namespace_available(), reason="needs root with util-linux unshare and setpriv")
+def test_forbidden_packages_are_gone_even_without_the_import_blocker(worker):
+    with pytest.raises(ImportError):
+        worker.call("evil", "import_sklearn_around_the_blocker", (), {})
 
 
 def test_the_reference_is_not_importable(worker):
