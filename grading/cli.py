@@ -112,6 +112,8 @@ def grade(args):
     print(format_report(summary, title))
     if args.results:
         print(f"Results written to {results}")
+    if args.require_full and summary["score"] < summary["max_score"]:
+        return 1
     return 0
 
 
@@ -177,6 +179,8 @@ def main(argv=None):
     g.add_argument("--junit", help="also write JUnit XML here")
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
     g.add_argument("--call-timeout", type=float, help="seconds one call of a submission may take (default 30)")
+    g.add_argument("--require-full", action="store_true",
+                   help="exit 1 unless every selected test passed (for GitHub Classroom steps)")
     g.add_argument("--impl-module", action="append", default=[], metavar="MODULE=FILE",
                    help=argparse.SUPPRESS)  # mutation checks: replace one module
     b = commands.add_parser("batch", help="grade every submission in a folder, in parallel")
@@ -185,7 +189,18 @@ def main(argv=None):
     b.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
     b.add_argument("--jobs", type=int, help="submissions graded at once (default: number of cores)")
     b.add_argument("-k", help="select tests as pytest -k does")
+    r = commands.add_parser("release", help="write the student repository (no solutions, no hidden tests)")
+    r.add_argument("out_dir", help="an empty or new folder")
     args = parser.parse_args(argv)
+    if args.command == "release":
+        from grading.release import release
+
+        leaks = release(args.out_dir)
+        if leaks:
+            print("error: the release contains reference code:\n" + "\n".join(leaks[:20]), file=sys.stderr)
+            return 1
+        print(f"Student repository written to {args.out_dir}")
+        return 0
     if args.command == "grade":
         return grade(args)
     if args.command == "batch":

@@ -114,7 +114,7 @@ class Worker:
     # -- process management ---------------------------------------------------
 
     def _command(self, nonce, work, clone):
-        python = [sys.executable, "-I", str(WORKER), clone, nonce, work]
+        python = [sys.executable, "-I", str(Path(work) / WORKER.name), clone, nonce, work]
         if not self.isolated:
             return python
         hidden = [REPO_ROOT / d for d in HIDDEN_FROM_SUBMISSIONS if (REPO_ROOT / d).is_dir()]
@@ -135,6 +135,7 @@ class Worker:
         clone = Path(self.work) / "submission"
         shutil.copytree(Path(self.clone_dir) / "pcl_course", clone / "pcl_course",
                         ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        shutil.copy(WORKER, Path(self.work) / WORKER.name)  # readable wherever the grader lives
         if self.isolated:
             for path in [Path(self.work), *Path(self.work).rglob("*")]:
                 os.chown(path, NOBODY, NOBODY)

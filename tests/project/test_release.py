@@ -1,0 +1,101 @@
+"""The student release (python -m grading release): what ships, what does
+not, that its grader gives the stubs 0 points without an error, and that
+the reference's code is caught if it slips in."""
+
+import json
+import shutil
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+from grading import GRADED_FUNCTIONS, REPO_ROOT
+from grading.leakcheck import find_leaks
+
+
+@pytest.fixture(scope="module")
+def release_dir(tmp_path_factory):
+    out = tmp_path_factory.mktemp("release") / "student"
+    completed = subprocess.run([sys.executable, "-m", "grading", "release", str(out)],
+                               cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    return out
+
+
+def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
+    for needed in ("Makefile", "README.md", "requirements.txt", "pyproject.toml", "_config.yml", "_toc.yml",
+                   ".ci/run", ".github/workflows/classroom.yml", "scripts/system-deps.sh",
+                   "pcl_course/pca.py", "grading/cli.py", "tests/graded/test_pca.py", "book/pca.md"):
+        assert (release_dir / needed).exists(), needed
+    for absent in ("solutions", "tests/mutants", "tests/alternatives", "tests/project", ".git"):
+        assert not (release_dir / absent).exists(), absent
+    for module in ("pca", "normals", "downsampling", "filters", "metrics"):
+        assert (release_dir / "pcl_course" / f"{module}.py").read_bytes() == \
+            (REPO_ROOT / "pcl_course" / f"{module}.py").read_bytes()
+    assert "REFERENCE_PACKAGE = None" in (release_dir / "pcl_course" / "book.py").read_text()
+
+
+def test_solution_blocks_are_removed_from_the_book(release_dir):
+    assert "{solution}" in (REPO_ROOT / "book" / "kernel_pca.md").read_text()  # there is one to remove
+    for page in (release_dir / "book").glob("*.md"):
+        assert "{solution}" not in page.read_text(), page.name
+    assert "{exercise}" in (release_dir / "book" / "kernel_pca.md").read_text()
+
+
+def test_the_release_contains_no_reference_code(release_dir):
+    assert find_leaks(release_dir) == []
+
+
+def test_the_leak_check_sees_through_renaming(release_dir, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(release_dir, copy)
+    # The reference chamfer_distance with every name changed, and a docstring.
+    renamed = (
+        "import numpy as np\n"
+        "from scipy.spatial import cKDTree\n"
+        "from pcl_course.validation import as_points\n\n\n"
+        "def chamfer_distance(p, q):\n"
+        "    \"\"\"My own work.\"\"\"\n"
+        "    p = as_points(p, 'a', allow_empty=False)[:, :3]\n"
+        "    q = as_points(q, 'b', allow_empty=False)[:, :3]\n"
+        "    there = cKDTree(q).query(p)[0]\n"
+        "    back = cKDTree(p).query(q)[0]\n"
+        "    return float(np.mean(there**2) + np.mean(back**2))\n"
+    )
+    (copy / "pcl_course" / "metrics.py").write_text(renamed)
+    leaks = find_leaks(copy)
+    assert any("chamfer_distance" in leak and "metrics.py" in leak for leak in leaks), leaks
+
+
+def test_the_classroom_workflow_grades_every_function(release_dir, reference_grading):
+    workflow = yaml.safe_load((release_dir / ".github" / "workflows" / "classroom.yml").read_text())
+    steps = [s for s in workflow["jobs"]["run-autograding-tests"]["steps"]
+             if s.get("uses", "").startswith("classroom-resources/autograding-command-grader")]
+    assert {s["with"]["test-name"] for s in steps} == set(GRADED_FUNCTIONS)
+    summary, _ = reference_grading
+    assert sum(s["with"]["max-score"] for s in steps) == summary["max_score"]
+
+
+def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
+    completed = subprocess.run([sys.executable, "-m", "grading", "grade", ".", "--results", "r.json"],
+                               cwd=release_dir, capture_output=True, text=True, timeout=600)
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    summary = json.loads((release_dir / "r.json").read_text())
+    assert summary["score"] == 0 and summary["max_score"] > 0
+    odd = [t for t in summary["tests"] if not t["output"].startswith("not implemented")]
+    assert not odd, [(t["name"], t["output"]) for t in odd[:3]]
+
+
+def test_the_release_book_builds_with_the_stubs(release_dir):
+    # The release's own pcl_course first on the path: the kernel must run the
+    # stubs, as in a student's fresh environment (where no solutions exist).
+    env = dict(__import__("os").environ, PYTHONPATH=str(release_dir))
+    completed = subprocess.run([str(REPO_ROOT / ".venv" / "bin" / "jupyter-book"), "build", ".", "-n",
+                                "--keep-going"], cwd=release_dir, capture_output=True, text=True,
+                               timeout=900, env=env)
+    assert completed.returncode == 0, completed.stdout[-3000:] + completed.stderr[-3000:]
+    page = (release_dir / "_build" / "html" / "book" / "pca.html").read_text()
+    assert "Not implemented yet: pca" in page
+    assert "lambda_k = sigma_k^2 / N: True" not in page  # no reference results
+    assert find_leaks(release_dir / "_build" / "html") == []
