@@ -13,7 +13,8 @@
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
-GRADED_TESTS = REPO_ROOT / "tests" / "graded"
+GRADED_TESTS = REPO_ROOT / "tests" / "graded"   # public: shipped to students
+HIDDEN_TESTS = REPO_ROOT / "tests" / "hidden"   # run only by the instructors' grader
 
 # Graded function -> exercise module; every name in ../shared/course-api.md.
 GRADED_FUNCTIONS = {

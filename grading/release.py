@@ -105,10 +105,11 @@ def _points_per_function():
     import json
     import tempfile
 
+    from grading import GRADED_TESTS
     from grading.cli import points_per_function, run_graded_tests
 
     results = Path(tempfile.mkdtemp()) / "results.json"
-    run_graded_tests(REPO_ROOT / "solutions", results)
+    run_graded_tests(REPO_ROOT / "solutions", results, tests=GRADED_TESTS)  # the public tests only
     return {f: maximum for f, (_, maximum) in points_per_function(json.loads(results.read_text())).items()}
 
 

@@ -91,3 +91,20 @@ def test_every_graded_function_has_wrong_and_alternative_submissions():
     for kind, files in (("mutants", MUTANTS), ("alternatives", ALTERNATIVES)):
         missing = set(GRADED_FUNCTIONS) - {path.parent.name for path in files}
         assert not missing, f"tests/{kind} has nothing for {sorted(missing)}"
+
+
+def test_hidden_tests_run_when_grading_and_withhold_their_details(tmp_path):
+    summary, _ = grade("--reference", "--impl-module",
+                       f"metrics={REPO_ROOT / 'tests' / 'mutants' / 'chamfer_distance' / 'unsquared.py'}",
+                       "-k", "test_chamfer_distance_", tmp_path=tmp_path)
+    hidden = [t for t in summary["tests"] if "_hidden_" in t["name"]]
+    assert hidden and all(t["status"] == "failed" for t in hidden)
+    assert all("hidden test: details withheld" in t["output"] and "\n" not in t["output"] for t in hidden)
+
+
+def test_junit_xml_is_written(tmp_path):
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "grade", "--reference", "-k", "test_pca_", "--junit",
+         str(tmp_path / "results.xml")], cwd=REPO_ROOT, capture_output=True, text=True)
+    assert completed.returncode == 0
+    assert "<testsuite" in (tmp_path / "results.xml").read_text()

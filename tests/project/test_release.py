@@ -28,7 +28,7 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
                    ".ci/run", ".github/workflows/classroom.yml", "scripts/system-deps.sh",
                    "pcl_course/pca.py", "grading/cli.py", "tests/graded/test_pca.py", "book/pca.md"):
         assert (release_dir / needed).exists(), needed
-    for absent in ("solutions", "tests/mutants", "tests/alternatives", "tests/project", ".git"):
+    for absent in ("solutions", "tests/mutants", "tests/alternatives", "tests/project", "tests/hidden", ".git"):
         assert not (release_dir / absent).exists(), absent
     for module in ("pca", "normals", "downsampling", "filters", "metrics"):
         assert (release_dir / "pcl_course" / f"{module}.py").read_bytes() == \
@@ -74,7 +74,8 @@ def test_the_classroom_workflow_grades_every_function(release_dir, reference_gra
              if s.get("uses", "").startswith("classroom-resources/autograding-command-grader")]
     assert {s["with"]["test-name"] for s in steps} == set(GRADED_FUNCTIONS)
     summary, _ = reference_grading
-    assert sum(s["with"]["max-score"] for s in steps) == summary["max_score"]
+    public = sum(t["max_score"] for t in summary["tests"] if "_hidden_" not in t["name"])
+    assert sum(s["with"]["max-score"] for s in steps) == public
 
 
 def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
