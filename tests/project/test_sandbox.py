@@ -83,6 +83,11 @@ EVIL = textwrap.dedent('''
         from sklearn.decomposition import PCA  # an empty directory stands where sklearn was
         return "imported"
 
+    def overwrite(path):
+        with open(path, "w") as handle:
+            handle.write('{"score": 999}')
+        return "written"
+
     def value_error():
         raise ValueError("points must be 2-D")
 ''').replace("REPO", repr(str(REPO_ROOT)))
@@ -197,3 +202,13 @@ def test_exit_at_import_and_tampering_files_change_nothing_else(tmp_path):
     assert chamfer and all(t["score"] == 0 for t in chamfer)
     assert pca and all(t["status"] == "passed" for t in pca)
     assert not marker.exists()
+
+
+@pytest.mark.skipif(not namespace_available(), reason="needs root with util-linux unshare and setpriv")
+def test_the_results_file_cannot_be_overwritten(worker, tmp_path):
+    # The grader writes its results in directories of its own (root, 0700).
+    results = tmp_path / "results.json"
+    results.write_text('{"score": 0}')
+    with pytest.raises(PermissionError):
+        worker.call("evil", "overwrite", (str(results),), {})
+    assert results.read_text() == '{"score": 0}'
