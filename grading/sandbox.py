@@ -37,14 +37,14 @@ from pathlib import Path
 import numpy as np
 
 from grading import REPO_ROOT
+from grading.forbidden import FORBIDDEN_PACKAGES
 
 WORKER = Path(__file__).with_name("worker.py")
 MEMORY_LIMIT = 4 * 1024**3      # bytes of address space
 CPU_LIMIT = 600                 # CPU seconds for a worker's whole life
 PROCESS_LIMIT = 256             # processes of the unprivileged user (fork bombs)
 NOBODY = 65534
-HIDDEN_FROM_SUBMISSIONS = ("solutions", "tests")
-FORBIDDEN_PACKAGES = ("open3d", "sklearn", "torch", "fpsample")  # installed ones are hidden in the namespace
+HIDDEN_FROM_SUBMISSIONS = ("solutions", "tests")  # and the installed FORBIDDEN_PACKAGES
 
 
 class SandboxError(Exception):
@@ -114,7 +114,8 @@ class Worker:
     # -- process management ---------------------------------------------------
 
     def _command(self, nonce, work, clone):
-        python = [sys.executable, "-I", str(Path(work) / WORKER.name), clone, nonce, work]
+        python = [sys.executable, "-I", str(Path(work) / WORKER.name), clone, nonce, work,
+                  ",".join(FORBIDDEN_PACKAGES)]
         if not self.isolated:
             return python
         hidden = [REPO_ROOT / d for d in HIDDEN_FROM_SUBMISSIONS if (REPO_ROOT / d).is_dir()]

@@ -7,7 +7,8 @@ whose arrays sit in an ``.npz`` file: plain data that the grader loads with
 ``allow_pickle=False``. The answer goes to a private copy of the original
 stdout, so that anything the submission prints goes to stderr instead.
 
-Usage: python -I worker.py CLONE_DIR NONCE WORK_DIR
+Usage: python -I worker.py CLONE_DIR NONCE WORK_DIR FORBIDDEN_PACKAGES
+(the last a comma-separated list, from grading.forbidden).
 """
 
 import importlib
@@ -27,14 +28,14 @@ def _hide_the_grader():
                         and "editable" not in getattr(f, "__name__", "").lower()]
 
 
-FORBIDDEN = {"open3d", "sklearn", "pcl", "pclpy", "torch", "torch_cluster", "pytorch3d", "fpsample"}
-
-
 class _ForbiddenImports:
     """A meta path finder that refuses the packages the homework forbids."""
 
+    def __init__(self, packages):
+        self.packages = set(packages)
+
     def find_spec(self, name, path=None, target=None):
-        if name.split(".")[0] in FORBIDDEN:
+        if name.split(".")[0] in self.packages:
             raise ImportError(f"{name} is not available to submissions: write your own code "
                               "(Open3D, PCL and scikit-learn are for visualisation only)")
         return None
@@ -70,12 +71,12 @@ def _where(exc):
 
 
 def main():
-    clone, nonce, work = sys.argv[1], sys.argv[2], sys.argv[3]
+    clone, nonce, work, forbidden = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split(",")
     protocol = os.fdopen(os.dup(1), "w", buffering=1)
     os.dup2(2, 1)  # the submission's prints go to stderr, not into the protocol
     requests = sys.stdin.buffer
     _hide_the_grader()
-    sys.meta_path.insert(0, _ForbiddenImports())
+    sys.meta_path.insert(0, _ForbiddenImports(forbidden))
     sys.path.insert(0, clone)
     import numpy as np
 
