@@ -6,7 +6,7 @@ import numbers
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcl_course.neighbors import knn
+from solutions._neighbors import grid_is_usable, grid_radius_count, kdtree
 from pcl_course.validation import as_array, as_points, check_integer, check_positive
 
 
@@ -17,9 +17,12 @@ def radius_outlier_removal(points, radius, min_neighbors):
     if len(points) == 0:
         return np.zeros(0, dtype=bool)
     xyz = points[:, :3]
-    # query_ball_point counts distances <= radius, the point itself included.
-    others = cKDTree(xyz).query_ball_point(xyz, r=radius, return_length=True) - 1
-    return others >= min_neighbors
+    # Both count distances <= radius, the point itself included.
+    if grid_is_usable(xyz, radius):
+        within = grid_radius_count(xyz, radius)
+    else:  # a radius tiny against the cloud's extent: too many cells for a grid
+        within = kdtree(xyz).query_ball_point(xyz, r=radius, return_length=True, workers=-1)
+    return within - 1 >= min_neighbors
 
 
 def _check_real(value, name):
@@ -35,8 +38,12 @@ def statistical_outlier_removal(points, k, std_ratio):
         check_integer(k, "k", low=1)
         return np.zeros(0, dtype=bool)
     k = check_integer(k, "k", low=1, high=len(points) - 1)
-    distances, _ = knn(points[:, :3], k, include_self=False)
-    mean_distance = distances.mean(axis=1)
+    xyz = points[:, :3]
+    distances, _ = kdtree(xyz).query(xyz, k=k + 1, workers=-1)
+    # The k + 1 nearest include the point itself at distance 0, or, if ties
+    # pushed it out, k + 1 duplicates all at distance 0: either way their sum
+    # is the sum over the k nearest others.
+    mean_distance = distances.reshape(len(xyz), k + 1).sum(axis=1) / k
     threshold = mean_distance.mean() + std_ratio * mean_distance.std(ddof=1)
     return mean_distance <= threshold
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 from scipy.linalg import eigh
+from scipy.sparse.linalg import ArpackNoConvergence, eigsh
 from scipy.spatial.distance import cdist
 
 from pcl_course.validation import as_array, as_points, check_choice, check_integer, check_positive
@@ -44,11 +45,36 @@ def kernel_matrix(x, y, kernel="gaussian", beta=1.0, degree=2):
         return (1.0 + x @ y.T) ** degree
     beta = check_positive(beta, "beta")
     metric = "sqeuclidean" if kernel == "gaussian" else "cityblock"
-    return np.exp(-beta * cdist(x, y, metric=metric))
+    gram = cdist(x, y, metric=metric)
+    gram *= -beta  # in place: no N x M temporaries
+    return np.exp(gram, out=gram)
 
 
 def _centring_terms(gram):
     return gram.mean(axis=0), gram.mean()
+
+
+def _top_eigenpairs(matrix, n_components):
+    """The ``n_components`` largest eigenvalues of a symmetric matrix, descending, and eigenvectors.
+
+    A few components of a large matrix: Lanczos iterations (ARPACK), which
+    only multiply by the matrix, O(N^2) each, instead of the O(N^3)
+    tridiagonalisation a dense solver needs even for one eigenpair. The
+    start vector is fixed, so results are reproducible. Many components, a
+    small matrix or no convergence: the dense LAPACK solver for just those.
+    """
+    n = matrix.shape[0]
+    if n > 200 and n_components < min(10, n // 20):
+        start = np.random.default_rng(0).uniform(-1.0, 1.0, n)
+        try:
+            eigenvalues, eigenvectors = eigsh(matrix, k=n_components, which="LA", v0=start)
+        except ArpackNoConvergence:
+            pass
+        else:
+            order = np.argsort(eigenvalues)[::-1]
+            return eigenvalues[order], eigenvectors[:, order]
+    eigenvalues, eigenvectors = eigh(matrix, subset_by_index=[n - n_components, n - 1])
+    return eigenvalues[::-1], eigenvectors[:, ::-1]
 
 
 def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
@@ -57,16 +83,19 @@ def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
     n_components = check_integer(n_components, "n_components", low=1, high=n)
     gram = kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
     column_means, grand_mean = _centring_terms(gram)
-    # K - 1_N K - K 1_N + 1_N K 1_N, without forming the N x N matrices 1_N.
-    centred = gram - column_means[None, :] - gram.mean(axis=1)[:, None] + grand_mean
-    # Only the top eigenpairs are needed: ask LAPACK for just those.
-    eigenvalues, eigenvectors = eigh(centred, subset_by_index=[n - n_components, n - 1])
-    eigenvalues, eigenvectors = eigenvalues[::-1], eigenvectors[:, ::-1]
+    # K - 1_N K - K 1_N + 1_N K 1_N, without forming the N x N matrices 1_N,
+    # in place. K is symmetric: its row means are its column means.
+    centred = gram
+    centred -= column_means[None, :]
+    centred -= column_means[:, None]
+    centred += grand_mean
+    eigenvalues, eigenvectors = _top_eigenpairs(centred, n_components)
     positive = eigenvalues > 0
     scale = np.zeros_like(eigenvalues)
     scale[positive] = 1.0 / np.sqrt(eigenvalues[positive])
     alphas = eigenvectors * scale
-    projections = centred @ alphas
+    # K~ alphas = K~ v / sqrt(l) = sqrt(l) v: no N x N product needed.
+    projections = eigenvectors * np.sqrt(np.clip(eigenvalues, 0.0, None))
     return projections, np.ascontiguousarray(eigenvalues), np.ascontiguousarray(alphas)
 
 
