@@ -2,6 +2,7 @@
 #   make book     set up, then build the book into _build/html
 #   make test     set up, build the book, run the whole test suite
 #   make grade SUBMISSION=dir    grade a student's clone
+#   make bench    time the references against Open3D, scikit-learn and fpsample
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -9,7 +10,7 @@ STAMP  := $(VENV)/.setup-done
 SUBMISSION ?=
 RESULTS ?= results/results.json
 
-.PHONY: setup book notebooks test grade requirements clean
+.PHONY: setup book notebooks test grade bench requirements clean
 
 setup: $(STAMP)
 
@@ -50,6 +51,19 @@ test: book notebooks
 grade: setup
 	@test -n "$(SUBMISSION)" || { echo "usage: make grade SUBMISSION=path/to/student/clone"; exit 2; }
 	$(BIN)/python -m grading grade "$(SUBMISSION)" --results "$(RESULTS)"
+
+# Benchmarks (benchmarks/README.md): pytest-benchmark, serial (no xdist: the
+# implementations use both cores), no per-test timeout. The summary, committed,
+# feeds the book's appendix. BENCH_ARGS passes options, e.g.
+#   make bench BENCH_ARGS="--bench-sizes=100000 -k normals"
+BENCH_ARGS ?=
+BENCH_OUT  ?= benchmarks/results
+bench: setup
+	mkdir -p _build/bench
+	$(BIN)/python -m pytest benchmarks -p no:xdist -p no:dash -p no:cacheprovider -o addopts= -o timeout=0 \
+	    -q --benchmark-json=_build/bench/raw.json --benchmark-save-data --benchmark-columns=median,iqr,rounds \
+	    --benchmark-sort=name $(BENCH_ARGS)
+	$(BIN)/python -m benchmarks.report _build/bench/raw.json $(BENCH_OUT)
 
 # Re-pin requirements.txt from requirements.in in a throw-away environment.
 requirements:

@@ -1,9 +1,9 @@
 """Reference: voxel grids, farthest point sampling, normal space sampling."""
 
 import numpy as np
-from numba import njit
 
 from pcl_course.validation import as_points, check_choice, check_integer, check_positive, check_rng
+from solutions._kernels import bucket_fps, hash_table_filter, reservoir_choice
 
 METHODS = ("centroid", "random")
 FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
@@ -64,22 +64,6 @@ def voxel_groups(h, dims):
     return groups.reshape(-1), len(unique)
 
 
-@njit(cache=True)
-def _reservoir_choice(groups, n_groups, uniform):
-    """One uniformly random member of every group, in one pass (reservoir sampling).
-
-    The ``c``-th member of a group replaces the choice with probability ``1/c``.
-    """
-    seen = np.zeros(n_groups, dtype=np.int64)
-    chosen = np.empty(n_groups, dtype=np.int64)
-    for i in range(groups.shape[0]):
-        g = groups[i]
-        seen[g] += 1
-        if uniform[i] * seen[g] < 1.0:
-            chosen[g] = i
-    return chosen
-
-
 def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
     points = as_points(points)
     voxel_size = check_positive(voxel_size, "voxel_size")
@@ -90,58 +74,10 @@ def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
     h, dims = voxel_coordinates(points[:, :3], voxel_size)
     groups, n_groups = voxel_groups(h, dims)
     if method == "random":
-        return points[_reservoir_choice(groups, n_groups, rng.random(len(points)))]
+        return points[reservoir_choice(groups, n_groups, rng.random(len(points)))]
     counts = np.bincount(groups, minlength=n_groups)
     columns = [np.bincount(groups, points[:, c], minlength=n_groups) for c in range(points.shape[1])]
     return np.stack(columns, axis=1) / counts[:, None]
-
-
-@njit(cache=True)
-def _hash_table_filter(containers, h, n_slots, values, uniform, centroid):
-    """The lecture's sequential conflict rule over containers ``0..n_slots-1``.
-
-    Returns the emitted rows: centroids (``centroid=True``) or the row index
-    chosen by reservoir sampling in each flushed container.
-    """
-    n, d = values.shape
-    occupied = np.zeros(n_slots, dtype=np.bool_)
-    held = np.empty((n_slots, 3), dtype=np.int64)
-    sums = np.zeros((n_slots, d))
-    counts = np.zeros(n_slots, dtype=np.int64)
-    chosen = np.empty(n_slots, dtype=np.int64)
-    out_rows = np.empty((n if centroid else 0, d))
-    out_index = np.empty(n, dtype=np.int64)
-    n_out = 0
-    for i in range(n + n_slots):
-        if i < n:
-            s = containers[i]
-            if not occupied[s] or (held[s, 0] == h[i, 0] and held[s, 1] == h[i, 1] and held[s, 2] == h[i, 2]):
-                flush = False
-            else:
-                flush = True
-        else:  # the final pass: every container still holding a voxel, in order
-            s = i - n
-            flush = occupied[s]
-        if flush:
-            if centroid:
-                for c in range(d):
-                    out_rows[n_out, c] = sums[s, c] / counts[s]
-            out_index[n_out] = chosen[s]
-            n_out += 1
-            occupied[s] = False
-        if i < n:
-            if not occupied[s]:
-                occupied[s] = True
-                held[s, 0], held[s, 1], held[s, 2] = h[i, 0], h[i, 1], h[i, 2]
-                counts[s] = 0
-                sums[s, :] = 0.0
-            counts[s] += 1
-            if centroid:
-                for c in range(d):
-                    sums[s, c] += values[i, c]
-            elif uniform[i] * counts[s] < 1.0:
-                chosen[s] = i
-    return out_rows[:n_out], out_index[:n_out]
 
 
 def approximate_voxel_downsample(points, voxel_size, n_containers, method="centroid", rng=None):
@@ -164,7 +100,7 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
         slots, n_slots = slots.reshape(-1), len(used)
     centroid = method == "centroid"
     uniform = np.empty(0) if centroid else rng.random(len(points))
-    rows, chosen = _hash_table_filter(slots, h, n_slots, points, uniform, centroid)
+    rows, chosen = hash_table_filter(slots, h, n_slots, points, uniform, centroid)
     return rows if centroid else points[chosen]
 
 
@@ -184,70 +120,6 @@ def _morton_order(xyz, bits=10):
     return np.argsort(code, kind="stable")
 
 
-@njit(cache=True)
-def _bucket_fps(x, y, z, ids, n_samples, start, bucket_size):
-    """Exact farthest point sampling over buckets of ``bucket_size`` consecutive points.
-
-    A bucket keeps its bounding box and the largest nearest-distance of its
-    points. A new sample can lower a point's distance only if it is closer to
-    that point than the point's current distance, so a bucket whose box is at
-    least its largest distance away is skipped. Floating-point rounding is
-    monotonic, so the skip is exact, not approximate. Ties go to the lowest
-    original index ``ids``.
-    """
-    n = x.shape[0]
-    n_buckets = (n + bucket_size - 1) // bucket_size
-    lower = np.empty((n_buckets, 3))
-    upper = np.empty((n_buckets, 3))
-    for b in range(n_buckets):
-        first = b * bucket_size
-        lower[b, 0] = upper[b, 0] = x[first]
-        lower[b, 1] = upper[b, 1] = y[first]
-        lower[b, 2] = upper[b, 2] = z[first]
-        for i in range(first + 1, min(n, first + bucket_size)):
-            lower[b, 0], upper[b, 0] = min(lower[b, 0], x[i]), max(upper[b, 0], x[i])
-            lower[b, 1], upper[b, 1] = min(lower[b, 1], y[i]), max(upper[b, 1], y[i])
-            lower[b, 2], upper[b, 2] = min(lower[b, 2], z[i]), max(upper[b, 2], z[i])
-    nearest = np.full(n, np.inf)
-    bucket_max = np.full(n_buckets, np.inf)
-    bucket_arg = np.zeros(n_buckets, dtype=np.int64)
-    selected = np.empty(n_samples, dtype=np.int64)
-    last = start
-    for j in range(n_samples):
-        selected[j] = ids[last]
-        nearest[last] = -1.0  # never selected again, even among duplicates
-        if j + 1 == n_samples:
-            break
-        cx, cy, cz = x[last], y[last], z[last]
-        own_bucket = last // bucket_size
-        for b in range(n_buckets):
-            if b != own_bucket:  # its maximum may have been the new sample
-                gx = max(lower[b, 0] - cx, 0.0, cx - upper[b, 0])
-                gy = max(lower[b, 1] - cy, 0.0, cy - upper[b, 1])
-                gz = max(lower[b, 2] - cz, 0.0, cz - upper[b, 2])
-                if gx * gx + gy * gy + gz * gz >= bucket_max[b]:
-                    continue
-            best, best_i = -np.inf, 0
-            for i in range(b * bucket_size, min(n, (b + 1) * bucket_size)):
-                dx, dy, dz = x[i] - cx, y[i] - cy, z[i] - cz
-                d = dx * dx + dy * dy + dz * dz
-                m = nearest[i]
-                if d < m:
-                    m = d
-                    nearest[i] = d
-                if m > best or (m == best and ids[i] < ids[best_i]):
-                    best, best_i = m, i
-            bucket_max[b], bucket_arg[b] = best, best_i
-        g = 0
-        for b in range(1, n_buckets):
-            if bucket_max[b] > bucket_max[g] or (
-                bucket_max[b] == bucket_max[g] and ids[bucket_arg[b]] < ids[bucket_arg[g]]
-            ):
-                g = b
-        last = bucket_arg[g]
-    return selected
-
-
 def farthest_point_sampling(points, n_samples, start_index=0):
     points = as_points(points)
     n = len(points)
@@ -260,7 +132,7 @@ def farthest_point_sampling(points, n_samples, start_index=0):
     position = np.empty(n, dtype=np.int64)
     position[order] = np.arange(n)
     x, y, z = (np.ascontiguousarray(xyz[order, axis]) for axis in range(3))
-    return _bucket_fps(x, y, z, order, n_samples, position[start_index], FPS_BUCKET_SIZE)
+    return bucket_fps(x, y, z, order, n_samples, position[start_index], FPS_BUCKET_SIZE)
 
 
 def normal_bucket_ids(normals, n_bins):

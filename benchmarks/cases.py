@@ -1,0 +1,225 @@
+"""What is benchmarked: each graded function against its best-known peers on the same input.
+
+A :class:`Case` is one function, one variant, one cloud kind and one size;
+its ``implementations`` map a name to a zero-argument callable that runs one
+call. ``reference`` is the course's reference (``solutions``); the others are
+peers from the libraries of the field. A case may carry a *target*: the
+largest allowed ratio of the reference's median time to one peer's, from
+issue 8.
+
+Graded functions without a library peer (``normal_space_sampling``, the
+bilateral filters, ``fit_plane``, ``depth_metrics``) are not here: there is
+nothing to compare with on the same definition.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import open3d as o3d
+
+from benchmarks.inputs import DATASETS, cloud, neighbourhood_radius
+
+SIZES = (10_000, 100_000, 1_000_000)
+KERNEL_SIZES = (500, 1000, 2000, 4000)  # O(N^2) memory and O(N^2)-O(N^3) time
+
+
+@dataclass(eq=False)  # hashed by identity: cached per case
+class Case:
+    function: str
+    variant: str
+    dataset: str
+    n_points: int
+    make: object  # () -> {name: callable}
+    parameters: dict = field(default_factory=dict)
+    target: tuple = None  # (peer name, largest ratio reference / peer)
+
+    @property
+    def id(self):
+        variant = f"[{self.variant}]" if self.variant else ""
+        return f"{self.function}{variant}-{self.dataset}-{self.n_points}"
+
+
+def _legacy(xyz):
+    return o3d.geometry.PointCloud(o3d.utility.Vector3dVector(np.array(xyz)))  # copies: the clouds are read-only
+
+
+def _tensor(xyz):
+    return o3d.t.geometry.PointCloud(o3d.core.Tensor(np.array(xyz)))
+
+
+def _voxel_cases(method, dataset, n):
+    voxel = neighbourhood_radius(dataset, n)
+
+    def make():
+        from solutions.downsampling import voxel_grid_downsample
+
+        xyz = cloud(dataset, n)
+        legacy, tensor = _legacy(xyz), _tensor(xyz)
+        impls = {"reference": lambda: voxel_grid_downsample(xyz, voxel, method=method, rng=0),
+                 "open3d": lambda: legacy.voxel_down_sample(voxel)}
+        if method == "centroid":
+            impls["open3d-tensor"] = lambda: tensor.voxel_down_sample(voxel)
+        return impls
+
+    target = ("open3d", 0.5) if n == 1_000_000 else None
+    return Case("voxel_grid_downsample", method, dataset, n, make, {"voxel_size": voxel}, target)
+
+
+def _approximate_voxel_case(dataset, n):
+    voxel = neighbourhood_radius(dataset, n)
+    containers = n // 8
+
+    def make():
+        from solutions.downsampling import approximate_voxel_downsample, voxel_grid_downsample
+
+        xyz = cloud(dataset, n)
+        return {"reference": lambda: approximate_voxel_downsample(xyz, voxel, containers),
+                "exact filter (reference)": lambda: voxel_grid_downsample(xyz, voxel)}
+
+    target = ("exact filter (reference)", 2.0) if n == 1_000_000 else None
+    return Case("approximate_voxel_downsample", "centroid", dataset, n, make,
+                {"voxel_size": voxel, "n_containers": containers}, target)
+
+
+def _normals_case(dataset, n):
+    def make():
+        from solutions.normals import estimate_normals
+
+        xyz = cloud(dataset, n)
+        legacy, tensor = _legacy(xyz), _tensor(xyz)
+        knn = o3d.geometry.KDTreeSearchParamKNN(30)
+        return {"reference": lambda: estimate_normals(xyz, k=30),
+                "open3d": lambda: legacy.estimate_normals(knn),
+                "open3d-tensor": lambda: tensor.estimate_normals(max_nn=30)}
+
+    target = ("open3d", 1.0) if n == 100_000 else None
+    return Case("estimate_normals", "knn30", dataset, n, make, {"k": 30}, target)
+
+
+def _fps_case(dataset, n):
+    m = 1024 if n < 100_000 else 4096
+
+    def make():
+        import fpsample
+
+        from solutions.downsampling import farthest_point_sampling
+
+        xyz = cloud(dataset, n)
+        legacy, tensor = _legacy(xyz), _tensor(xyz)
+        impls = {"reference": lambda: farthest_point_sampling(xyz, m),
+                 "open3d": lambda: legacy.farthest_point_down_sample(m),
+                 "fpsample-bucket": lambda: fpsample.bucket_fps_kdline_sampling(xyz, m, h=7, start_idx=0)}
+        if n < 1_000_000:  # the plain O(N M) loop: about a minute per call at a million points
+            impls["fpsample-plain"] = lambda: fpsample.fps_sampling(xyz, m, start_idx=0)
+        if n < 100_000:  # one tensor operation per sample: 0.2 s for 1024 of 2000 points, minutes beyond
+            impls["open3d-tensor"] = lambda: tensor.farthest_point_down_sample(m)
+        return impls
+
+    target = ("open3d", 1.0) if n == 100_000 else None
+    return Case("farthest_point_sampling", f"to{m}", dataset, n, make, {"n_samples": m}, target)
+
+
+def _sor_case(dataset, n):
+    def make():
+        from solutions.filters import statistical_outlier_removal
+
+        xyz = cloud(dataset, n)
+        legacy, tensor = _legacy(xyz), _tensor(xyz)
+        # Open3D counts the point itself among its nb_neighbors: k + 1.
+        return {"reference": lambda: statistical_outlier_removal(xyz, 20, 2.0),
+                "open3d": lambda: legacy.remove_statistical_outlier(21, 2.0),
+                "open3d-tensor": lambda: tensor.remove_statistical_outliers(21, 2.0)}
+
+    target = ("open3d", 1.0) if n == 100_000 else None
+    return Case("statistical_outlier_removal", "k20", dataset, n, make, {"k": 20, "std_ratio": 2.0}, target)
+
+
+def _ror_case(dataset, n):
+    radius = neighbourhood_radius(dataset, n)
+
+    def make():
+        from solutions.filters import radius_outlier_removal
+
+        xyz = cloud(dataset, n)
+        legacy, tensor = _legacy(xyz), _tensor(xyz)
+        # Open3D's tensor filter counts the point itself: m + 1.
+        return {"reference": lambda: radius_outlier_removal(xyz, radius, 8),
+                "open3d": lambda: legacy.remove_radius_outlier(8, radius),
+                "open3d-tensor": lambda: tensor.remove_radius_outliers(9, radius)}
+
+    target = ("open3d", 1.0) if n == 100_000 else None
+    return Case("radius_outlier_removal", "m8", dataset, n, make, {"radius": radius, "min_neighbors": 8}, target)
+
+
+def _kernel_pca_case(dataset, n):
+    beta = 10.0
+
+    def make():
+        from sklearn.decomposition import KernelPCA
+
+        from solutions.pca import kernel_pca
+
+        xyz = cloud(dataset, n)
+        return {"reference": lambda: kernel_pca(xyz, 2, "gaussian", beta=beta),
+                "scikit-learn": lambda: KernelPCA(2, kernel="rbf", gamma=beta).fit_transform(xyz)}
+
+    target = ("scikit-learn", 1.0) if n == 2000 else None
+    return Case("kernel_pca", "gaussian2", dataset, n, make, {"n_components": 2, "beta": beta}, target)
+
+
+def _kernel_matrix_case(n):
+    def make():
+        from sklearn.metrics.pairwise import rbf_kernel
+
+        from solutions.pca import kernel_matrix
+
+        xyz = cloud("cube", n)
+        return {"reference": lambda: kernel_matrix(xyz, xyz, "gaussian", beta=10.0),
+                "scikit-learn": lambda: rbf_kernel(xyz, xyz, gamma=10.0)}
+
+    return Case("kernel_matrix", "gaussian", "cube", n, make, {"beta": 10.0})
+
+
+def _pca_case(n):
+    def make():
+        from sklearn.decomposition import PCA
+
+        from solutions.pca import pca
+
+        xyz = cloud("cube", n)
+        return {"reference": lambda: pca(xyz), "scikit-learn": lambda: PCA().fit(xyz)}
+
+    return Case("pca", "", "cube", n, make)
+
+
+def _chamfer_case(n):
+    def make():
+        from solutions.metrics import chamfer_distance
+
+        a = cloud("shape", n)
+        b = a + np.random.default_rng(1).normal(scale=0.01, size=a.shape)
+        pa, pb = _legacy(a), _legacy(b)
+
+        def open3d_chamfer():
+            ab = np.asarray(pa.compute_point_cloud_distance(pb))
+            ba = np.asarray(pb.compute_point_cloud_distance(pa))
+            return np.mean(ab**2) + np.mean(ba**2)
+
+        return {"reference": lambda: chamfer_distance(a, b), "open3d": open3d_chamfer}
+
+    return Case("chamfer_distance", "", "shape", n, make)
+
+
+def all_cases(sizes=SIZES, kernel_sizes=KERNEL_SIZES, datasets=DATASETS):
+    """Every case, in the order they run."""
+    cases = []
+    for dataset in datasets:
+        for n in sizes:
+            cases += [_voxel_cases("centroid", dataset, n), _voxel_cases("random", dataset, n),
+                      _approximate_voxel_case(dataset, n), _normals_case(dataset, n), _fps_case(dataset, n),
+                      _sor_case(dataset, n), _ror_case(dataset, n)]
+    for dataset in (d for d in datasets if d != "scan"):
+        cases += [_kernel_pca_case(dataset, n) for n in kernel_sizes]
+    cases += [_kernel_matrix_case(n) for n in kernel_sizes]
+    cases += [_pca_case(n) for n in sizes] + [_chamfer_case(n) for n in sizes]
+    return cases

@@ -1,0 +1,297 @@
+"""Compiled inner loops of the references (numba), one per sequential algorithm.
+
+They live in their own module, always imported as ``solutions._kernels``,
+because numba's on-disk cache (``cache=True``, which saves the one to two
+seconds of compilation per function in every new process) remembers the
+module name a function was compiled under: the grader loads the exercise
+modules under private names, and a kernel defined there would find a cache
+written under another name.
+"""
+
+import numpy as np
+from numba import njit
+
+
+# --- downsampling ---------------------------------------------------------------
+
+@njit(cache=True)
+def reservoir_choice(groups, n_groups, uniform):
+    """One uniformly random member of every group, in one pass (reservoir sampling).
+
+    The ``c``-th member of a group replaces the choice with probability ``1/c``.
+    """
+    seen = np.zeros(n_groups, dtype=np.int64)
+    chosen = np.empty(n_groups, dtype=np.int64)
+    for i in range(groups.shape[0]):
+        g = groups[i]
+        seen[g] += 1
+        if uniform[i] * seen[g] < 1.0:
+            chosen[g] = i
+    return chosen
+
+
+@njit(cache=True)
+def hash_table_filter(containers, h, n_slots, values, uniform, centroid):
+    """The lecture's sequential conflict rule over containers ``0..n_slots-1``.
+
+    Returns the emitted rows: centroids (``centroid=True``) or the row index
+    chosen by reservoir sampling in each flushed container.
+    """
+    n, d = values.shape
+    occupied = np.zeros(n_slots, dtype=np.bool_)
+    held = np.empty((n_slots, 3), dtype=np.int64)
+    sums = np.zeros((n_slots, d))
+    counts = np.zeros(n_slots, dtype=np.int64)
+    chosen = np.empty(n_slots, dtype=np.int64)
+    out_rows = np.empty((n if centroid else 0, d))
+    out_index = np.empty(n, dtype=np.int64)
+    n_out = 0
+    for i in range(n + n_slots):
+        if i < n:
+            s = containers[i]
+            if not occupied[s] or (held[s, 0] == h[i, 0] and held[s, 1] == h[i, 1] and held[s, 2] == h[i, 2]):
+                flush = False
+            else:
+                flush = True
+        else:  # the final pass: every container still holding a voxel, in order
+            s = i - n
+            flush = occupied[s]
+        if flush:
+            if centroid:
+                for c in range(d):
+                    out_rows[n_out, c] = sums[s, c] / counts[s]
+            out_index[n_out] = chosen[s]
+            n_out += 1
+            occupied[s] = False
+        if i < n:
+            if not occupied[s]:
+                occupied[s] = True
+                held[s, 0], held[s, 1], held[s, 2] = h[i, 0], h[i, 1], h[i, 2]
+                counts[s] = 0
+                sums[s, :] = 0.0
+            counts[s] += 1
+            if centroid:
+                for c in range(d):
+                    sums[s, c] += values[i, c]
+            elif uniform[i] * counts[s] < 1.0:
+                chosen[s] = i
+    return out_rows[:n_out], out_index[:n_out]
+
+
+@njit(cache=True)
+def bucket_fps(x, y, z, ids, n_samples, start, bucket_size):
+    """Exact farthest point sampling over buckets of ``bucket_size`` consecutive points.
+
+    A bucket keeps its bounding box and the largest nearest-distance of its
+    points. A new sample can lower a point's distance only if it is closer to
+    that point than the point's current distance, so a bucket whose box is at
+    least its largest distance away is skipped. Floating-point rounding is
+    monotonic, so the skip is exact, not approximate. Ties go to the lowest
+    original index ``ids``.
+    """
+    n = x.shape[0]
+    n_buckets = (n + bucket_size - 1) // bucket_size
+    lower = np.empty((n_buckets, 3))
+    upper = np.empty((n_buckets, 3))
+    for b in range(n_buckets):
+        first = b * bucket_size
+        lower[b, 0] = upper[b, 0] = x[first]
+        lower[b, 1] = upper[b, 1] = y[first]
+        lower[b, 2] = upper[b, 2] = z[first]
+        for i in range(first + 1, min(n, first + bucket_size)):
+            lower[b, 0], upper[b, 0] = min(lower[b, 0], x[i]), max(upper[b, 0], x[i])
+            lower[b, 1], upper[b, 1] = min(lower[b, 1], y[i]), max(upper[b, 1], y[i])
+            lower[b, 2], upper[b, 2] = min(lower[b, 2], z[i]), max(upper[b, 2], z[i])
+    nearest = np.full(n, np.inf)
+    bucket_max = np.full(n_buckets, np.inf)
+    bucket_arg = np.zeros(n_buckets, dtype=np.int64)
+    selected = np.empty(n_samples, dtype=np.int64)
+    last = start
+    for j in range(n_samples):
+        selected[j] = ids[last]
+        nearest[last] = -1.0  # never selected again, even among duplicates
+        if j + 1 == n_samples:
+            break
+        cx, cy, cz = x[last], y[last], z[last]
+        own_bucket = last // bucket_size
+        for b in range(n_buckets):
+            if b != own_bucket:  # its maximum may have been the new sample
+                gx = max(lower[b, 0] - cx, 0.0, cx - upper[b, 0])
+                gy = max(lower[b, 1] - cy, 0.0, cy - upper[b, 1])
+                gz = max(lower[b, 2] - cz, 0.0, cz - upper[b, 2])
+                if gx * gx + gy * gy + gz * gz >= bucket_max[b]:
+                    continue
+            best, best_i = -np.inf, 0
+            for i in range(b * bucket_size, min(n, (b + 1) * bucket_size)):
+                dx, dy, dz = x[i] - cx, y[i] - cy, z[i] - cz
+                d = dx * dx + dy * dy + dz * dz
+                m = nearest[i]
+                if d < m:
+                    m = d
+                    nearest[i] = d
+                if m > best or (m == best and ids[i] < ids[best_i]):
+                    best, best_i = m, i
+            bucket_max[b], bucket_arg[b] = best, best_i
+        g = 0
+        for b in range(1, n_buckets):
+            if bucket_max[b] > bucket_max[g] or (
+                bucket_max[b] == bucket_max[g] and ids[bucket_arg[b]] < ids[bucket_arg[g]]
+            ):
+                g = b
+        last = bucket_arg[g]
+    return selected
+
+
+
+# --- normals --------------------------------------------------------------------
+
+@njit(cache=True, inline="always")
+def _eigenvector(a00, a01, a02, a11, a12, a22, value):
+    """Unit null vector of ``A - value I``: the longest cross product of two of its rows."""
+    r0x, r0y, r0z = a00 - value, a01, a02
+    r1x, r1y, r1z = a01, a11 - value, a12
+    r2x, r2y, r2z = a02, a12, a22 - value
+    c01 = (r0y * r1z - r0z * r1y, r0z * r1x - r0x * r1z, r0x * r1y - r0y * r1x)
+    c02 = (r0y * r2z - r0z * r2y, r0z * r2x - r0x * r2z, r0x * r2y - r0y * r2x)
+    c12 = (r1y * r2z - r1z * r2y, r1z * r2x - r1x * r2z, r1x * r2y - r1y * r2x)
+    d01 = c01[0] ** 2 + c01[1] ** 2 + c01[2] ** 2
+    d02 = c02[0] ** 2 + c02[1] ** 2 + c02[2] ** 2
+    d12 = c12[0] ** 2 + c12[1] ** 2 + c12[2] ** 2
+    best, d = c01, d01
+    if d02 > d:
+        best, d = c02, d02
+    if d12 > d:
+        best, d = c12, d12
+    if d == 0.0:  # A - value I is zero: every vector is an eigenvector
+        return 1.0, 0.0, 0.0
+    inv = 1.0 / np.sqrt(d)
+    return best[0] * inv, best[1] * inv, best[2] * inv
+
+
+@njit(cache=True, inline="always")
+def _second_eigenvector(a00, a01, a02, a11, a12, a22, w, value):
+    """Eigenvector of ``value`` orthogonal to the unit eigenvector ``w``: a 2x2 problem in w's complement."""
+    if abs(w[0]) > abs(w[1]):
+        inv = 1.0 / np.sqrt(w[0] * w[0] + w[2] * w[2])
+        u = (-w[2] * inv, 0.0, w[0] * inv)
+    else:
+        inv = 1.0 / np.sqrt(w[1] * w[1] + w[2] * w[2])
+        u = (0.0, w[2] * inv, -w[1] * inv)
+    v = (w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0])
+    au = (a00 * u[0] + a01 * u[1] + a02 * u[2], a01 * u[0] + a11 * u[1] + a12 * u[2], a02 * u[0] + a12 * u[1] + a22 * u[2])
+    av = (a00 * v[0] + a01 * v[1] + a02 * v[2], a01 * v[0] + a11 * v[1] + a12 * v[2], a02 * v[0] + a12 * v[1] + a22 * v[2])
+    m00 = u[0] * au[0] + u[1] * au[1] + u[2] * au[2] - value
+    m01 = u[0] * av[0] + u[1] * av[1] + u[2] * av[2]
+    m11 = v[0] * av[0] + v[1] * av[1] + v[2] * av[2] - value
+    # Null vector (c_u, c_v) of [[m00, m01], [m01, m11]], normalised without overflow.
+    if abs(m00) >= abs(m11):
+        if max(abs(m00), abs(m01)) == 0.0:
+            return u
+        if abs(m00) >= abs(m01):
+            m01 /= m00
+            m00 = 1.0 / np.sqrt(1.0 + m01 * m01)
+            m01 *= m00
+        else:
+            m00 /= m01
+            m01 = 1.0 / np.sqrt(1.0 + m00 * m00)
+            m00 *= m01
+        cu, cv = m01, -m00
+    else:
+        if max(abs(m11), abs(m01)) == 0.0:
+            return u
+        if abs(m11) >= abs(m01):
+            m01 /= m11
+            m11 = 1.0 / np.sqrt(1.0 + m01 * m01)
+            m01 *= m11
+        else:
+            m11 /= m01
+            m01 = 1.0 / np.sqrt(1.0 + m11 * m11)
+            m11 *= m01
+        cu, cv = m11, -m01
+    return (cu * u[0] + cv * v[0], cu * u[1] + cv * v[1], cu * u[2] + cv * v[2])
+
+
+@njit(cache=True)
+def smallest_eigenpair(a00, a01, a02, a11, a12, a22):
+    """Smallest eigenvalue of a symmetric 3x3 matrix and a unit eigenvector of it, in closed form.
+
+    Eberly's noniterative solver ("A Robust Eigensolver for 3x3 Symmetric
+    Matrices", Geometric Tools, 2014), the one Open3D uses: scale by the
+    largest entry, eigenvalues from the trigonometric solution of the
+    characteristic cubic, then the eigenvector of the *better separated*
+    extreme eigenvalue from cross products, the middle one from a 2x2 problem
+    in its orthogonal complement, and the remaining one as their cross
+    product. Solving for the separated eigenvalue first keeps flat patches
+    (two large, one tiny eigenvalue) and lines (one large, two tiny) accurate.
+
+    Returns
+    -------
+    value : float
+    nx, ny, nz : float
+    """
+    scale = max(abs(a00), abs(a01), abs(a02), abs(a11), abs(a12), abs(a22))
+    if scale == 0.0:
+        return 0.0, 1.0, 0.0, 0.0
+    a00, a01, a02, a11, a12, a22 = a00 / scale, a01 / scale, a02 / scale, a11 / scale, a12 / scale, a22 / scale
+    q = (a00 + a11 + a22) / 3.0
+    b00, b11, b22 = a00 - q, a11 - q, a22 - q
+    p = np.sqrt((b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * (a01 * a01 + a02 * a02 + a12 * a12)) / 6.0)
+    if p == 0.0:  # a multiple of the identity
+        return q * scale, 1.0, 0.0, 0.0
+    c00 = b11 * b22 - a12 * a12
+    c01 = a01 * b22 - a12 * a02
+    c02 = a01 * a12 - b11 * a02
+    half_det = (b00 * c00 - a01 * c01 + a02 * c02) / (2.0 * p * p * p)
+    half_det = min(max(half_det, -1.0), 1.0)
+    angle = np.arccos(half_det) / 3.0
+    beta2 = 2.0 * np.cos(angle)
+    beta0 = 2.0 * np.cos(angle + 2.0 * np.pi / 3.0)
+    beta1 = -(beta0 + beta2)
+    value0, value1, value2 = q + p * beta0, q + p * beta1, q + p * beta2
+    if half_det >= 0.0:  # the largest eigenvalue is the separated one
+        w2 = _eigenvector(a00, a01, a02, a11, a12, a22, value2)
+        w1 = _second_eigenvector(a00, a01, a02, a11, a12, a22, w2, value1)
+        n = (w1[1] * w2[2] - w1[2] * w2[1], w1[2] * w2[0] - w1[0] * w2[2], w1[0] * w2[1] - w1[1] * w2[0])
+    else:
+        n = _eigenvector(a00, a01, a02, a11, a12, a22, value0)
+    return value0 * scale, n[0], n[1], n[2]
+
+
+@njit(cache=True)
+def normals_from_neighbourhoods(points, members, offsets):
+    """Normal and curvature of every neighbourhood ``members[offsets[i]:offsets[i+1]]``.
+
+    Two-pass covariance (centred on the neighbourhood's own mean before
+    multiplying), so that coordinates far from the origin do not cancel
+    catastrophically; then the closed-form smallest eigenpair.
+    """
+    n = offsets.shape[0] - 1
+    normals = np.full((n, 3), np.nan)
+    curvature = np.full(n, np.nan)
+    for i in range(n):
+        start, stop = offsets[i], offsets[i + 1]
+        count = stop - start
+        if count < 3:
+            continue
+        mx = my = mz = 0.0
+        for j in range(start, stop):
+            p = members[j]
+            mx += points[p, 0]
+            my += points[p, 1]
+            mz += points[p, 2]
+        mx, my, mz = mx / count, my / count, mz / count
+        sxx = sxy = sxz = syy = syz = szz = 0.0
+        for j in range(start, stop):
+            p = members[j]
+            dx, dy, dz = points[p, 0] - mx, points[p, 1] - my, points[p, 2] - mz
+            sxx += dx * dx
+            sxy += dx * dy
+            sxz += dx * dz
+            syy += dy * dy
+            syz += dy * dz
+            szz += dz * dz
+        value, nx, ny, nz = smallest_eigenpair(sxx, sxy, sxz, syy, syz, szz)
+        normals[i, 0], normals[i, 1], normals[i, 2] = nx, ny, nz
+        trace = sxx + syy + szz
+        curvature[i] = max(value, 0.0) / trace if trace > 0.0 else 0.0
+    return normals, curvature
