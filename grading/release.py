@@ -18,7 +18,7 @@ from grading import GRADED_FUNCTIONS, REPO_ROOT
 from grading.leakcheck import find_leaks
 
 COPIED = ["pcl_course", "grading", "tests/graded", "book", "scripts", "_toc.yml", "requirements.txt",
-          "requirements.in", ".gitignore"]
+          "requirements.in", ".gitignore", "benchmarks/results"]  # the appendix reads the results, not the harness
 IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".ipynb_checkpoints")
 
 STUDENT_MAKEFILE = """\

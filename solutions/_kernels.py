@@ -12,7 +12,79 @@ import numpy as np
 from numba import njit
 
 
+def axis_bounds(xyz):
+    """Per-column minimum and maximum of an ``(N, D)`` array.
+
+    Column by column: NumPy's ``xyz.min(axis=0)`` on a C-ordered ``(N, 3)``
+    array walks it with a stride-3 inner loop, measured 10x slower (34 ms
+    against 3.4 ms for a million points).
+    """
+    lower = np.array([xyz[:, c].min() for c in range(xyz.shape[1])])
+    upper = np.array([xyz[:, c].max() for c in range(xyz.shape[1])])
+    return lower, upper
+
+
 # --- downsampling ---------------------------------------------------------------
+
+
+@njit(cache=True)
+def voxel_keys(xyz, lower, voxel_size, dim_x, dim_y):
+    """Linear voxel index of every point, ``h_x + h_y D_x + h_z D_x D_y``, in one pass.
+
+    ``h = floor((p - lower) / voxel_size)``, evaluated as NumPy would; the
+    caller guarantees that the grid fits int64. One fused loop instead of
+    NumPy's four full-size temporaries.
+    """
+    n = xyz.shape[0]
+    keys = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        hx = np.int64(np.floor((xyz[i, 0] - lower[0]) / voxel_size))
+        hy = np.int64(np.floor((xyz[i, 1] - lower[1]) / voxel_size))
+        hz = np.int64(np.floor((xyz[i, 2] - lower[2]) / voxel_size))
+        keys[i] = hx + dim_x * (hy + dim_y * hz)
+    return keys
+
+
+@njit(cache=True)
+def hash_groups(keys):
+    """Group id of every key, numbered by first appearance, with an open-addressing hash table.
+
+    Returns ``(groups, uniques)``: ``uniques[groups[i]] == keys[i]``. Expected
+    O(N): a multiplicative (Fibonacci) hash into a table of at least 2N slots,
+    linear probing. Consecutive equal keys (a scan visits a voxel several
+    times in a row) skip the table.
+    """
+    n = keys.shape[0]
+    bits = 1
+    while (1 << bits) < 2 * n:
+        bits += 1
+    mask = (1 << bits) - 1
+    shift = np.uint64(64 - bits)
+    golden = np.uint64(0x9E3779B97F4A7C15)
+    slot_key = np.empty(mask + 1, dtype=np.int64)
+    slot_group = np.full(mask + 1, -1, dtype=np.int64)
+    groups = np.empty(n, dtype=np.int64)
+    uniques = np.empty(n, dtype=np.int64)
+    m = 0
+    for i in range(n):
+        key = keys[i]
+        if i > 0 and key == keys[i - 1]:
+            groups[i] = groups[i - 1]
+            continue
+        slot = np.int64((np.uint64(key) * golden) >> shift)
+        while True:
+            if slot_group[slot] < 0:
+                slot_key[slot] = key
+                slot_group[slot] = m
+                uniques[m] = key
+                groups[i] = m
+                m += 1
+                break
+            if slot_key[slot] == key:
+                groups[i] = slot_group[slot]
+                break
+            slot = (slot + 1) & mask
+    return groups, uniques[:m]
 
 @njit(cache=True)
 def reservoir_choice(groups, n_groups, uniform):
@@ -31,15 +103,18 @@ def reservoir_choice(groups, n_groups, uniform):
 
 
 @njit(cache=True)
-def hash_table_filter(containers, h, n_slots, values, uniform, centroid):
+def hash_table_filter(containers, voxels, n_slots, values, uniform, centroid):
     """The lecture's sequential conflict rule over containers ``0..n_slots-1``.
 
+    ``voxels`` identifies each point's voxel: one column (the linear index)
+    or three (the coordinates, when the linear index overflows int64).
     Returns the emitted rows: centroids (``centroid=True``) or the row index
     chosen by reservoir sampling in each flushed container.
     """
     n, d = values.shape
     occupied = np.zeros(n_slots, dtype=np.bool_)
-    held = np.empty((n_slots, 3), dtype=np.int64)
+    width = voxels.shape[1]
+    held = np.empty((n_slots, width), dtype=np.int64)
     sums = np.zeros((n_slots, d))
     counts = np.zeros(n_slots, dtype=np.int64)
     chosen = np.empty(n_slots, dtype=np.int64)
@@ -49,10 +124,11 @@ def hash_table_filter(containers, h, n_slots, values, uniform, centroid):
     for i in range(n + n_slots):
         if i < n:
             s = containers[i]
-            if not occupied[s] or (held[s, 0] == h[i, 0] and held[s, 1] == h[i, 1] and held[s, 2] == h[i, 2]):
-                flush = False
-            else:
-                flush = True
+            flush = False
+            if occupied[s]:
+                for c in range(width):
+                    if held[s, c] != voxels[i, c]:
+                        flush = True
         else:  # the final pass: every container still holding a voxel, in order
             s = i - n
             flush = occupied[s]
@@ -66,7 +142,8 @@ def hash_table_filter(containers, h, n_slots, values, uniform, centroid):
         if i < n:
             if not occupied[s]:
                 occupied[s] = True
-                held[s, 0], held[s, 1], held[s, 2] = h[i, 0], h[i, 1], h[i, 2]
+                for c in range(width):
+                    held[s, c] = voxels[i, c]
                 counts[s] = 0
                 sums[s, :] = 0.0
             counts[s] += 1
@@ -222,7 +299,8 @@ def smallest_eigenpair(a00, a01, a02, a11, a12, a22):
     extreme eigenvalue from cross products, the middle one from a 2x2 problem
     in its orthogonal complement, and the remaining one as their cross
     product. Solving for the separated eigenvalue first keeps flat patches
-    (two large, one tiny eigenvalue) and lines (one large, two tiny) accurate.
+    (two large, one tiny eigenvalue) and lines (one large, two tiny) accurate;
+    the returned eigenvalue is the Rayleigh quotient of the eigenvector.
 
     Returns
     -------
@@ -254,7 +332,12 @@ def smallest_eigenpair(a00, a01, a02, a11, a12, a22):
         n = (w1[1] * w2[2] - w1[2] * w2[1], w1[2] * w2[0] - w1[0] * w2[2], w1[0] * w2[1] - w1[1] * w2[0])
     else:
         n = _eigenvector(a00, a01, a02, a11, a12, a22, value0)
-    return value0 * scale, n[0], n[1], n[2]
+    # The trigonometric root loses half the digits at a double root (a line:
+    # two eigenvalues zero); the Rayleigh quotient of the accurate vector
+    # does not.
+    rayleigh = (a00 * n[0] * n[0] + a11 * n[1] * n[1] + a22 * n[2] * n[2]
+                + 2.0 * (a01 * n[0] * n[1] + a02 * n[0] * n[2] + a12 * n[1] * n[2]))
+    return rayleigh * scale, n[0], n[1], n[2]
 
 
 @njit(cache=True)

@@ -30,6 +30,8 @@ import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
+from solutions._kernels import axis_bounds
+
 # Cells along one axis beyond which the rounding of the cell assignment could
 # reach the margin below; callers then use a k-d tree.
 MAX_CELLS_PER_AXIS = 2**20
@@ -60,9 +62,9 @@ class Grid:
 
     def __init__(self, xyz, cell):
         self.cell = float(cell)
-        self.lower = xyz.min(axis=0)
+        self.lower, _ = axis_bounds(xyz)
         coords = np.floor((xyz - self.lower) / self.cell).astype(np.int64)
-        self.dims = coords.max(axis=0) + 1
+        self.dims = np.array([coords[:, c].max() for c in range(3)]) + 1
         key = coords[:, 0] + self.dims[0] * (coords[:, 1] + self.dims[1] * coords[:, 2])
         self.order = np.argsort(key, kind="stable")
         sorted_key = key[self.order]
@@ -77,7 +79,8 @@ def grid_is_usable(xyz, radius):
     """Whether the grid for ``radius`` over ``xyz`` stays small enough for int64 keys and exact margins."""
     if len(xyz) == 0 or not radius > 0:
         return False
-    extent = (xyz.max(axis=0) - xyz.min(axis=0)) / (radius * (1.0 + CELL_MARGIN))
+    lower, upper = axis_bounds(xyz)
+    extent = (upper - lower) / (radius * (1.0 + CELL_MARGIN))
     if np.any(extent >= MAX_CELLS_PER_AXIS):
         return False
     return float(np.prod(extent + 1)) < 2.0**62

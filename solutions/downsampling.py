@@ -3,7 +3,7 @@
 import numpy as np
 
 from pcl_course.validation import as_points, check_choice, check_integer, check_positive, check_rng
-from solutions._kernels import bucket_fps, hash_table_filter, reservoir_choice
+from solutions._kernels import axis_bounds, bucket_fps, hash_groups, hash_table_filter, reservoir_choice, voxel_keys
 
 METHODS = ("centroid", "random")
 FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
@@ -14,9 +14,9 @@ def voxel_coordinates(xyz, voxel_size):
 
     ``D`` stays a tuple of Python ints so that products of it never overflow.
     """
-    lower = xyz.min(axis=0)
+    lower, upper = axis_bounds(xyz)
     h = np.floor((xyz - lower) / voxel_size).astype(np.int64)
-    dims = tuple(int(d) + 1 for d in np.floor((xyz.max(axis=0) - lower) / voxel_size))
+    dims = tuple(int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
     return h, dims
 
 
@@ -36,7 +36,7 @@ def _group_sorted(h):
     return groups, int(new_voxel.sum())
 
 
-def voxel_groups(h, dims):
+def voxel_groups(xyz, voxel_size):
     """Voxel id of every point, numbered ``0..M-1`` in increasing linear index.
 
     Returns
@@ -47,21 +47,28 @@ def voxel_groups(h, dims):
 
     Notes
     -----
-    Three strategies, by grid size: a grid of at most ``8 N`` cells is a dense
-    table (a counting pass, O(N + cells), no sorting); a larger one that still
-    fits int64 sorts the linear indices (O(N log N) on one key); beyond int64
-    the coordinates are sorted lexicographically (three keys, slowest).
+    Three strategies, by grid size. A grid of at most ``8 N`` cells is a
+    dense table: a counting pass marks the occupied cells and a cumulative
+    sum numbers them, O(N + cells), no sorting. A larger grid that fits int64
+    is hashed: O(N) expected to find the M occupied voxels, then only those M
+    keys are sorted. Beyond int64 the coordinates are sorted
+    lexicographically (three keys, slowest, exact).
     """
+    lower, upper = axis_bounds(xyz)
+    dims = tuple(int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
     n_cells = dims[0] * dims[1] * dims[2]  # Python ints: never overflows
     if n_cells > np.iinfo(np.int64).max:
+        h, _ = voxel_coordinates(xyz, voxel_size)
         return _group_sorted(h)
-    linear = h[:, 0] + dims[0] * (h[:, 1] + dims[1] * h[:, 2])
-    if n_cells <= 8 * len(h):
+    linear = voxel_keys(xyz, lower, voxel_size, dims[0], dims[1])
+    if n_cells <= 8 * len(xyz):
         occupied = np.bincount(linear, minlength=n_cells) > 0
         rank = np.cumsum(occupied) - 1
         return rank[linear], int(rank[-1]) + 1
-    unique, groups = np.unique(linear, return_inverse=True)
-    return groups.reshape(-1), len(unique)
+    groups, uniques = hash_groups(linear)
+    rank = np.empty(len(uniques), dtype=np.int64)
+    rank[np.argsort(uniques)] = np.arange(len(uniques))
+    return rank[groups], len(uniques)
 
 
 def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
@@ -71,13 +78,22 @@ def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
     rng = check_rng(rng)
     if len(points) == 0:
         return np.empty((0, points.shape[1]))
-    h, dims = voxel_coordinates(points[:, :3], voxel_size)
-    groups, n_groups = voxel_groups(h, dims)
+    groups, n_groups = voxel_groups(points[:, :3], voxel_size)
     if method == "random":
         return points[reservoir_choice(groups, n_groups, rng.random(len(points)))]
     counts = np.bincount(groups, minlength=n_groups)
     columns = [np.bincount(groups, points[:, c], minlength=n_groups) for c in range(points.shape[1])]
     return np.stack(columns, axis=1) / counts[:, None]
+
+
+def _linear_index_modulo(h, dx, dy, m):
+    """``(h_x + h_y D_x + h_z D_x D_y) % m`` exactly, for a linear index beyond int64."""
+    if m < 2**31:  # term by term: every product of two residues stays below 2^62
+        return (h[:, 0] % m + (h[:, 1] % m) * (dx % m) % m + (h[:, 2] % m) * ((dx * dy) % m) % m) % m
+    # Residues near 2^63 would overflow their products: Python integers (rare, slow),
+    # kept as objects when m itself exceeds int64.
+    exact = [(x + y * dx + z * dx * dy) % m for x, y, z in h.tolist()]
+    return np.array(exact, dtype=np.int64 if m <= np.iinfo(np.int64).max else object)
 
 
 def approximate_voxel_downsample(points, voxel_size, n_containers, method="centroid", rng=None):
@@ -88,26 +104,38 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
     rng = check_rng(rng)
     if len(points) == 0:
         return np.empty((0, points.shape[1]))
-    h, (dx, dy, _) = voxel_coordinates(points[:, :3], voxel_size)
-    # linear_index % n_containers, computed modulo n_containers term by term
-    # so that it stays exact when the linear index overflows int64.
     m = n_containers
-    containers = (h[:, 0] % m + (h[:, 1] % m) * (dx % m) % m + (h[:, 2] % m) * ((dx * dy) % m) % m) % m
-    if m <= 4 * len(points):
-        slots, n_slots = containers, m
-    else:  # renumber the containers in use, keeping their order, so tables stay O(N)
-        used, slots = np.unique(containers, return_inverse=True)
-        slots, n_slots = slots.reshape(-1), len(used)
+    xyz = points[:, :3]
+    lower, upper = axis_bounds(xyz)
+    dx, dy, dz = (int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
+    n_cells = dx * dy * dz  # Python ints: exact
+    if m >= n_cells:
+        # Every voxel has a container of its own (its linear index), and
+        # containers in increasing order are voxels in increasing linear index.
+        slots, n_slots = voxel_groups(xyz, voxel_size)
+        voxels = slots[:, None]
+    else:
+        if n_cells <= np.iinfo(np.int64).max:  # the linear index itself fits (and so does m)
+            voxels = voxel_keys(xyz, lower, voxel_size, dx, dy)
+            containers, voxels = voxels % m, voxels[:, None]
+        else:
+            voxels, _ = voxel_coordinates(xyz, voxel_size)
+            containers = _linear_index_modulo(voxels, dx, dy, m)
+        if m <= 4 * len(points):
+            slots, n_slots = containers, m
+        else:  # renumber the containers in use, keeping their order, so tables stay O(N)
+            used, slots = np.unique(containers, return_inverse=True)
+            slots, n_slots = slots.reshape(-1).astype(np.int64), len(used)
     centroid = method == "centroid"
     uniform = np.empty(0) if centroid else rng.random(len(points))
-    rows, chosen = hash_table_filter(slots, h, n_slots, points, uniform, centroid)
+    rows, chosen = hash_table_filter(slots, voxels, n_slots, points, uniform, centroid)
     return rows if centroid else points[chosen]
 
 
 def _morton_order(xyz, bits=10):
     """Indices that sort the points along a Z-order curve (nearby points, nearby ranks)."""
-    lower = xyz.min(axis=0)
-    span = float((xyz.max(axis=0) - lower).max()) or 1.0
+    lower, upper = axis_bounds(xyz)
+    span = float((upper - lower).max()) or 1.0
     cells = np.minimum((xyz - lower) / span * (1 << bits), (1 << bits) - 1).astype(np.uint64)
 
     def spread(v):  # insert two zero bits between the bits of a 10-bit integer

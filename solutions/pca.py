@@ -2,7 +2,7 @@
 
 import numpy as np
 from scipy.linalg import eigh
-from scipy.sparse.linalg import ArpackNoConvergence, eigsh
+from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 from scipy.spatial.distance import cdist
 
 from pcl_course.validation import as_array, as_points, check_choice, check_integer, check_positive
@@ -54,26 +54,40 @@ def _centring_terms(gram):
     return gram.mean(axis=0), gram.mean()
 
 
-def _top_eigenpairs(matrix, n_components):
-    """The ``n_components`` largest eigenvalues of a symmetric matrix, descending, and eigenvectors.
+def _top_eigenpairs(gram, n_components):
+    """The ``n_components`` largest eigenvalues of the centred Gram matrix, descending, and eigenvectors.
 
     A few components of a large matrix: Lanczos iterations (ARPACK), which
     only multiply by the matrix, O(N^2) each, instead of the O(N^3)
     tridiagonalisation a dense solver needs even for one eigenpair. The
-    start vector is fixed, so results are reproducible. Many components, a
-    small matrix or no convergence: the dense LAPACK solver for just those.
+    centring is applied inside each product, never to the matrix:
+    ``K~ v = K v - mean(K v) - r sum(v) + mean(K) sum(v)``, ``r`` the row
+    means of ``K``. The start vector is fixed, so results are reproducible.
+    Many components, a small matrix or no convergence: the dense LAPACK
+    solver on the centred matrix, for just those eigenpairs.
     """
-    n = matrix.shape[0]
+    n = gram.shape[0]
+    row_means, grand_mean = _centring_terms(gram)  # K is symmetric: row means are column means
     if n > 200 and n_components < min(10, n // 20):
+
+        def centred_product(v):
+            v = v.reshape(n, -1)
+            kv = gram @ v
+            total = v.sum(axis=0)
+            return kv - kv.mean(axis=0) - row_means[:, None] * total + grand_mean * total
+
+        operator = LinearOperator((n, n), matvec=centred_product, matmat=centred_product, dtype=np.float64)
         start = np.random.default_rng(0).uniform(-1.0, 1.0, n)
         try:
-            eigenvalues, eigenvectors = eigsh(matrix, k=n_components, which="LA", v0=start)
+            eigenvalues, eigenvectors = eigsh(operator, k=n_components, which="LA", v0=start)
         except ArpackNoConvergence:
             pass
         else:
             order = np.argsort(eigenvalues)[::-1]
             return eigenvalues[order], eigenvectors[:, order]
-    eigenvalues, eigenvectors = eigh(matrix, subset_by_index=[n - n_components, n - 1])
+    # K - 1_N K - K 1_N + 1_N K 1_N, without forming the N x N matrices 1_N.
+    centred = gram - row_means[None, :] - row_means[:, None] + grand_mean
+    eigenvalues, eigenvectors = eigh(centred, subset_by_index=[n - n_components, n - 1])
     return eigenvalues[::-1], eigenvectors[:, ::-1]
 
 
@@ -82,14 +96,7 @@ def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
     n = points.shape[0]
     n_components = check_integer(n_components, "n_components", low=1, high=n)
     gram = kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
-    column_means, grand_mean = _centring_terms(gram)
-    # K - 1_N K - K 1_N + 1_N K 1_N, without forming the N x N matrices 1_N,
-    # in place. K is symmetric: its row means are its column means.
-    centred = gram
-    centred -= column_means[None, :]
-    centred -= column_means[:, None]
-    centred += grand_mean
-    eigenvalues, eigenvectors = _top_eigenpairs(centred, n_components)
+    eigenvalues, eigenvectors = _top_eigenpairs(gram, n_components)
     positive = eigenvalues > 0
     scale = np.zeros_like(eigenvalues)
     scale[positive] = 1.0 / np.sqrt(eigenvalues[positive])

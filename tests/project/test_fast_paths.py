@@ -1,0 +1,241 @@
+"""The references' fast paths (issue 8) give the answers of the plain implementations.
+
+The graded tests check the references against the contract; these check
+each optimisation where it could go wrong: the bucket-pruned farthest point
+sampling must pick the *same* indices as the plain loop (ties included), the
+voxel filters' three grouping strategies and the compiled hash table must
+group exactly as the plain versions, the closed-form eigensolver must match
+LAPACK on flat, linear, isotropic and badly scaled matrices, the grid radius
+count must equal the k-d tree's count at exactly the radius, and the Lanczos
+path of kernel PCA must match the dense solver.
+"""
+
+import numpy as np
+import plain  # tests/project/plain.py
+import pytest
+
+from solutions import downsampling, filters, normals, pca
+from solutions._kernels import hash_groups, smallest_eigenpair
+from solutions._neighbors import grid_is_usable, grid_radius_count
+
+RNG = np.random.default_rng(20261122)
+
+
+def _clouds():
+    """Clouds that stress the fast paths: volume, surface, line, lattice ties, duplicates, far away."""
+    cube = RNG.random((3000, 3))
+    plane = np.c_[RNG.random((2000, 2)), np.zeros(2000)]
+    line = np.c_[RNG.random(500), np.zeros((500, 2))]
+    lattice = np.stack(np.meshgrid(*[np.arange(7.0)] * 3), -1).reshape(-1, 3)
+    duplicates = np.repeat(RNG.random((60, 3)), 4, axis=0)
+    far = RNG.random((1500, 3)) * [3.0, 2.0, 0.1] + 1e6
+    return {"cube": cube, "plane": plane, "line": line, "lattice": lattice, "duplicates": duplicates, "far": far}
+
+
+CLOUDS = _clouds()
+
+
+# --- farthest point sampling: identical indices --------------------------------
+
+
+@pytest.mark.parametrize("name", sorted(CLOUDS))
+def test_bucket_fps_selects_the_same_indices_as_the_plain_loop(name):
+    points = CLOUDS[name]
+    n = len(points)
+    for n_samples, start in ((min(n, 400), 0), (n, n // 3), (1, n - 1)):
+        expected = plain.farthest_point_sampling(points, n_samples, start)
+        result = downsampling.farthest_point_sampling(points, n_samples, start_index=start)
+        np.testing.assert_array_equal(result, expected, err_msg=f"{name}: {n_samples} from {start}")
+
+
+def test_bucket_fps_ignores_extra_columns_and_uses_small_buckets():
+    points = np.c_[RNG.random((700, 3)), RNG.random((700, 2)) * 100]
+    expected = plain.farthest_point_sampling(points, 300, 5)
+    np.testing.assert_array_equal(downsampling.farthest_point_sampling(points, 300, start_index=5), expected)
+
+
+# --- voxel grid: every grouping strategy ------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "voxel_size, strategy",
+    [(0.1, "dense table"), (0.004, "hashed int64 keys"), (1e-16, "lexicographic, beyond int64")],
+)
+def test_voxel_grid_centroids_equal_the_plain_groups(voxel_size, strategy):
+    points = np.c_[RNG.random((4000, 3)) * [1.0, 2.0, 3.0], RNG.random(4000)]
+    h, dims = downsampling.voxel_coordinates(points[:, :3], voxel_size)
+    cells = dims[0] * dims[1] * dims[2]
+    used = "dense table" if cells <= 8 * len(points) else "hashed int64 keys" if cells < 2**63 else "lexicographic, beyond int64"
+    assert used == strategy
+    expected = plain.voxel_grid_centroids(points, voxel_size)
+    result = downsampling.voxel_grid_downsample(points, voxel_size)
+    np.testing.assert_allclose(result, expected, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("voxel_size", [0.1, 0.004, 1e-16])
+def test_voxel_grid_random_rows_come_one_from_each_voxel_in_order(voxel_size):
+    points = RNG.random((3000, 3))
+    groups = plain.voxel_groups(points, voxel_size)
+    result = downsampling.voxel_grid_downsample(points, voxel_size, method="random", rng=3)
+    assert len(result) == len(groups)
+    for row, members in zip(result, groups):
+        assert any(np.array_equal(row, points[m]) for m in members)
+
+
+@pytest.mark.parametrize("keys", [
+    RNG.integers(0, 50, 5000),                       # few keys, many repeats
+    RNG.integers(0, 2**62, 3000),                    # all distinct
+    np.arange(0, 2**40, 2**30),                      # a stride that collides in a small table
+    np.repeat(RNG.integers(0, 10**12, 400), 5),      # runs of equal keys (the scan case)
+])
+def test_hash_groups_numbers_keys_by_first_appearance(keys):
+    keys = np.ascontiguousarray(keys, dtype=np.int64)
+    groups, uniques = hash_groups(keys)
+    np.testing.assert_array_equal(uniques[groups], keys)
+    _, first = np.unique(keys, return_index=True)
+    np.testing.assert_array_equal(uniques, keys[np.sort(first)])
+
+
+def test_reservoir_choice_is_uniform_within_a_voxel():
+    # One voxel of 4 rows: each must come out about 1/4 of the time.
+    points = np.array([[0.1, 0.1, 0.1], [0.2, 0.2, 0.2], [0.3, 0.3, 0.3], [0.4, 0.4, 0.4]])
+    rng = np.random.default_rng(0)
+    picks = [downsampling.voxel_grid_downsample(points, 1.0, method="random", rng=rng)[0, 0] for _ in range(4000)]
+    counts = np.unique(picks, return_counts=True)[1]
+    assert len(counts) == 4 and np.all(np.abs(counts - 1000) < 5 * np.sqrt(4000 * 0.25 * 0.75))
+
+
+# --- approximate voxel grid: the compiled hash table --------------------------------
+
+
+@pytest.mark.parametrize("n_containers", [1, 7, 500, 10**6, 2**31 + 11, 2**62])
+@pytest.mark.parametrize("voxel_size", [0.1, 1e-16])  # linear index within int64, and beyond
+def test_hash_table_filter_emits_the_plain_groups(n_containers, voxel_size):
+    # Scan-like order (sorted along x with noise) makes conflicts frequent.
+    points = RNG.random((2500, 4))
+    points = points[np.argsort(points[:, 0] + 0.05 * RNG.random(2500))]
+    groups = plain.approximate_voxel_groups(points, voxel_size, n_containers)
+    expected = np.array([points[g].mean(axis=0) for g in groups])
+    result = downsampling.approximate_voxel_downsample(points, voxel_size, n_containers)
+    np.testing.assert_allclose(result, expected, rtol=1e-12, atol=1e-15)
+    chosen = downsampling.approximate_voxel_downsample(points, voxel_size, n_containers, method="random", rng=1)
+    assert len(chosen) == len(groups)
+    for row, members in zip(chosen, groups):
+        assert any(np.array_equal(row, points[m]) for m in members)
+
+
+def test_hash_table_filter_with_more_containers_than_int64():
+    points = RNG.random((2000, 3))
+    # More containers than cells: every voxel has its own, the exact filter.
+    result = downsampling.approximate_voxel_downsample(points, 0.1, 10**20)
+    np.testing.assert_allclose(result, plain.voxel_grid_centroids(points, 0.1), rtol=1e-12, atol=1e-15)
+    # A grid beyond int64 too: one point per voxel, emitted in container order
+    # (the linear index modulo 10^20, in Python integers).
+    h, (dx, dy, _) = plain.voxel_coordinates(points, 1e-16)
+    containers = [(x + y * dx + z * dx * dy) % 10**20 for x, y, z in h.tolist()]
+    assert len(set(containers)) == len(points)
+    result = downsampling.approximate_voxel_downsample(points, 1e-16, 10**20)
+    np.testing.assert_array_equal(result, points[np.argsort(np.array(containers, dtype=object))])
+
+
+# --- closed-form 3x3 eigensolver vs LAPACK ------------------------------------------
+
+
+def _symmetric_matrices():
+    rotations = np.linalg.qr(RNG.standard_normal((400, 3, 3)))[0]
+    spectra = {
+        "random": RNG.random((400, 3)),
+        "flat patch": np.c_[np.zeros(400), RNG.random((400, 2)) + 0.5],
+        "noisy flat": np.c_[1e-12 * RNG.random(400), RNG.random((400, 2)) + 0.5],
+        "line": np.c_[np.zeros((400, 2)), RNG.random(400) + 0.5],
+        "isotropic": np.ones((400, 3)),
+        "near-degenerate top": np.c_[RNG.random(400) * 0.1, np.ones((400, 2)) + 1e-9 * RNG.random((400, 2))],
+        "tiny": RNG.random((400, 3)) * 1e-20,
+        "huge": RNG.random((400, 3)) * 1e20,
+    }
+    for name, values in spectra.items():
+        yield name, np.einsum("nij,nj,nkj->nik", rotations, values, rotations)
+    axis_aligned = np.zeros((3, 3, 3))
+    for i in range(3):
+        axis_aligned[i] = np.diag(np.roll([0.0, 1.0, 2.0], i))
+    yield "axis-aligned", axis_aligned
+    yield "zero", np.zeros((1, 3, 3))
+
+
+@pytest.mark.parametrize("name, matrices", list(_symmetric_matrices()), ids=lambda v: v if isinstance(v, str) else "")
+def test_smallest_eigenpair_matches_lapack(name, matrices):
+    matrices = (matrices + matrices.transpose(0, 2, 1)) / 2
+    values, vectors = np.linalg.eigh(matrices)
+    for a, w, v in zip(matrices, values, vectors):
+        scale = max(np.abs(w).max(), np.finfo(float).tiny)
+        value, *normal = smallest_eigenpair(a[0, 0], a[0, 1], a[0, 2], a[1, 1], a[1, 2], a[2, 2])
+        normal = np.array(normal)
+        assert abs(value - w[0]) <= 1e-12 * scale, name
+        assert abs(np.linalg.norm(normal) - 1.0) < 1e-12, name
+        assert np.linalg.norm(a @ normal - value * normal) <= 1e-10 * scale, name
+        if w[1] - w[0] > 1e-6 * scale:  # a unique direction: it must be LAPACK's (up to sign)
+            assert abs(abs(normal @ v[:, 0]) - 1.0) < 1e-9, name
+
+
+@pytest.mark.parametrize("name", ["cube", "plane", "far"])
+@pytest.mark.parametrize("k, radius", [(30, None), (8, None), (None, 0.08), (12, 0.08)])
+def test_estimate_normals_matches_the_plain_eigh(name, k, radius):
+    points = CLOUDS[name]
+    if radius is not None:
+        radius *= float(np.ptp(points, axis=0).max())
+    expected_normals, expected_curvature = plain.estimate_normals(points, k, radius)
+    result_normals, result_curvature = normals.estimate_normals(points, k=k, radius=radius)
+    finite = np.isfinite(expected_curvature)
+    np.testing.assert_array_equal(np.isfinite(result_curvature), finite)
+    np.testing.assert_allclose(np.abs(np.sum(result_normals[finite] * expected_normals[finite], axis=1)), 1.0, atol=1e-8)
+    np.testing.assert_allclose(result_curvature[finite], expected_curvature[finite], rtol=1e-9, atol=1e-12)
+
+
+# --- filters ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name", sorted(CLOUDS))
+@pytest.mark.parametrize("relative_radius", [0.01, 0.05, 0.3])
+def test_grid_radius_count_equals_the_kdtree_count(name, relative_radius):
+    points = CLOUDS[name]
+    radius = relative_radius * float(np.ptp(points, axis=0).max())
+    assert grid_is_usable(points, radius)
+    np.testing.assert_array_equal(grid_radius_count(points, radius) - 1, plain.radius_neighbour_counts(points, radius))
+
+
+def test_grid_radius_count_includes_neighbours_at_exactly_the_radius():
+    lattice = CLOUDS["lattice"]  # unit spacing: many pairs exactly 1 and sqrt(2) apart
+    for radius in (1.0, np.sqrt(2.0), 2.0):
+        np.testing.assert_array_equal(grid_radius_count(lattice, radius) - 1, plain.radius_neighbour_counts(lattice, radius))
+
+
+def test_radius_outlier_removal_falls_back_to_the_tree_for_huge_grids():
+    points = np.r_[RNG.random((500, 3)) * 1e-3, [[1e6, 0.0, 0.0]]]
+    assert not grid_is_usable(points, 1e-4)
+    expected = plain.radius_neighbour_counts(points, 1e-4) >= 2
+    np.testing.assert_array_equal(filters.radius_outlier_removal(points, 1e-4, 2), expected)
+
+
+@pytest.mark.parametrize("name", sorted(CLOUDS))
+def test_statistical_outlier_removal_matches_the_plain_mask(name):
+    points = CLOUDS[name]
+    for k in (1, 4, 20):
+        np.testing.assert_array_equal(
+            filters.statistical_outlier_removal(points, k, 1.0), plain.statistical_outlier_mask(points, k, 1.0)
+        )
+
+
+# --- kernel PCA: Lanczos vs dense --------------------------------------------------------
+
+
+@pytest.mark.parametrize("kernel, beta", [("gaussian", 10.0), ("laplacian", 3.0), ("polynomial", 1.0)])
+def test_kernel_pca_lanczos_matches_the_dense_solver(kernel, beta):
+    points = RNG.random((600, 3))
+    projections, eigenvalues, alphas = pca.kernel_pca(points, 3, kernel=kernel, beta=beta)
+    gram = pca.kernel_matrix(points, points, kernel=kernel, beta=beta)
+    ones = np.full_like(gram, 1.0 / len(gram))
+    centred = gram - ones @ gram - gram @ ones + ones @ gram @ ones
+    values, vectors = plain.kernel_pca_eigenpairs(centred, 3)
+    np.testing.assert_allclose(eigenvalues, values, rtol=1e-9)
+    np.testing.assert_allclose(np.abs(alphas.T @ vectors), np.diag(1.0 / np.sqrt(values)), atol=1e-7 / np.sqrt(values.min()))
+    np.testing.assert_allclose(projections, centred @ alphas, atol=1e-9 * np.abs(projections).max())
