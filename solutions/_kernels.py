@@ -288,7 +288,7 @@ def _second_eigenvector(a00, a01, a02, a11, a12, a22, w, value):
     return (cu * u[0] + cv * v[0], cu * u[1] + cv * v[1], cu * u[2] + cv * v[2])
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def smallest_eigenpair(a00, a01, a02, a11, a12, a22):
     """Smallest eigenvalue of a symmetric 3x3 matrix and a unit eigenvector of it, in closed form.
 
@@ -340,41 +340,49 @@ def smallest_eigenpair(a00, a01, a02, a11, a12, a22):
     return rayleigh * scale, n[0], n[1], n[2]
 
 
-@njit(cache=True)
-def normals_from_neighbourhoods(points, members, offsets):
-    """Normal and curvature of every neighbourhood ``members[offsets[i]:offsets[i+1]]``.
+@njit(cache=True, nogil=True)
+def patch_normal(points, members, start, stop):
+    """Normal and curvature of the neighbourhood ``points[members[start:stop]]`` (at least 3 points).
 
     Two-pass covariance (centred on the neighbourhood's own mean before
     multiplying), so that coordinates far from the origin do not cancel
     catastrophically; then the closed-form smallest eigenpair.
+
+    Returns
+    -------
+    nx, ny, nz, curvature : float
     """
+    count = stop - start
+    mx = my = mz = 0.0
+    for j in range(start, stop):
+        p = members[j]
+        mx += points[p, 0]
+        my += points[p, 1]
+        mz += points[p, 2]
+    mx, my, mz = mx / count, my / count, mz / count
+    sxx = sxy = sxz = syy = syz = szz = 0.0
+    for j in range(start, stop):
+        p = members[j]
+        dx, dy, dz = points[p, 0] - mx, points[p, 1] - my, points[p, 2] - mz
+        sxx += dx * dx
+        sxy += dx * dy
+        sxz += dx * dz
+        syy += dy * dy
+        syz += dy * dz
+        szz += dz * dz
+    value, nx, ny, nz = smallest_eigenpair(sxx, sxy, sxz, syy, syz, szz)
+    trace = sxx + syy + szz
+    return nx, ny, nz, (max(value, 0.0) / trace if trace > 0.0 else 0.0)
+
+
+@njit(cache=True)
+def normals_from_neighbourhoods(points, members, offsets):
+    """Normal and curvature of every neighbourhood ``members[offsets[i]:offsets[i+1]]``; NaN below 3 points."""
     n = offsets.shape[0] - 1
     normals = np.full((n, 3), np.nan)
     curvature = np.full(n, np.nan)
     for i in range(n):
-        start, stop = offsets[i], offsets[i + 1]
-        count = stop - start
-        if count < 3:
-            continue
-        mx = my = mz = 0.0
-        for j in range(start, stop):
-            p = members[j]
-            mx += points[p, 0]
-            my += points[p, 1]
-            mz += points[p, 2]
-        mx, my, mz = mx / count, my / count, mz / count
-        sxx = sxy = sxz = syy = syz = szz = 0.0
-        for j in range(start, stop):
-            p = members[j]
-            dx, dy, dz = points[p, 0] - mx, points[p, 1] - my, points[p, 2] - mz
-            sxx += dx * dx
-            sxy += dx * dy
-            sxz += dx * dz
-            syy += dy * dy
-            syz += dy * dz
-            szz += dz * dz
-        value, nx, ny, nz = smallest_eigenpair(sxx, sxy, sxz, syy, syz, szz)
-        normals[i, 0], normals[i, 1], normals[i, 2] = nx, ny, nz
-        trace = sxx + syy + szz
-        curvature[i] = max(value, 0.0) / trace if trace > 0.0 else 0.0
+        if offsets[i + 1] - offsets[i] >= 3:
+            normals[i, 0], normals[i, 1], normals[i, 2], curvature[i] = patch_normal(
+                points, members, offsets[i], offsets[i + 1])
     return normals, curvature

@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
-from solutions._kernels import axis_bounds
+from solutions._kernels import axis_bounds, patch_normal
 
 # Cells along one axis beyond which the rounding of the cell assignment could
 # reach the margin below; callers then use a k-d tree.
@@ -114,9 +114,12 @@ def _radius_count_range(points, coords, keys, starts, dims, radius_sq, first, la
         out_count[q] = count
 
 
-def _in_threads(kernel, n, inputs, outputs):
-    """Call ``kernel(*inputs, first, last, *outputs)`` on slices of ``0..n-1``, one per core."""
-    workers = max(1, min(os.cpu_count() or 1, n // 4096))
+def _in_threads(kernel, n, inputs, outputs, grain=4096):
+    """Call ``kernel(*inputs, first, last, *outputs)`` on slices of ``0..n-1``, one per core.
+
+    Slices of fewer than ``grain`` items are not worth a thread.
+    """
+    workers = max(1, min(os.cpu_count() or 1, n // grain))
     bounds = np.linspace(0, n, workers + 1).astype(np.int64)
     if workers == 1:
         kernel(*inputs, 0, n, *outputs)
@@ -137,3 +140,252 @@ def grid_radius_count(xyz, radius):
     result = np.empty_like(count)
     result[grid.order] = count
     return result
+
+
+# --- k nearest neighbours of every point: leaves along a Z-order curve ------------------
+
+LEAF_SIZE = 32
+
+
+def _spread_bits(v):
+    """Insert two zero bits between the low 21 bits of each uint64 (for 63-bit Morton codes)."""
+    v = v & np.uint64(0x1FFFFF)
+    v = (v | (v << np.uint64(32))) & np.uint64(0x1F00000000FFFF)
+    v = (v | (v << np.uint64(16))) & np.uint64(0x1F0000FF0000FF)
+    v = (v | (v << np.uint64(8))) & np.uint64(0x100F00F00F00F00F)
+    v = (v | (v << np.uint64(4))) & np.uint64(0x10C30C30C30C30C3)
+    return (v | (v << np.uint64(2))) & np.uint64(0x1249249249249249)
+
+
+def morton_order(xyz):
+    """Indices that sort the points along a Z-order curve at 2^21 cells per axis.
+
+    Nearby ranks are nearby points: consecutive runs of the sorted cloud are
+    compact boxes, which is what makes them useful leaves.
+    """
+    lower, upper = axis_bounds(xyz)
+    span = float((upper - lower).max()) or 1.0
+    cells = np.minimum((xyz - lower) * ((2**21 - 1) / span), 2**21 - 1).astype(np.uint64)
+    code = _spread_bits(cells[:, 0]) | (_spread_bits(cells[:, 1]) << np.uint64(1)) | (
+        _spread_bits(cells[:, 2]) << np.uint64(2))
+    return np.argsort(code, kind="stable")
+
+
+@njit(cache=True)
+def _leaf_hierarchy(points, leaf_size):
+    """A binary tree over the leaves (runs of ``leaf_size`` sorted points), with bounding boxes.
+
+    Node 0 is the root; a node covers leaves ``first[i]..last[i]-1``; ``left``
+    and ``right`` are its children (-1 for a leaf node).
+    """
+    n = points.shape[0]
+    n_leaves = (n + leaf_size - 1) // leaf_size
+    size = 2 * n_leaves
+    first = np.empty(size, dtype=np.int64)
+    last = np.empty(size, dtype=np.int64)
+    left = np.full(size, -1, dtype=np.int64)
+    right = np.full(size, -1, dtype=np.int64)
+    lower = np.empty((size, 3))
+    upper = np.empty((size, 3))
+    first[0], last[0] = 0, n_leaves
+    count = 1
+    for node in range(size):  # parents come before their children
+        if node >= count:
+            break
+        if last[node] - first[node] > 1:
+            middle = (first[node] + last[node]) // 2
+            left[node], right[node] = count, count + 1
+            first[count], last[count] = first[node], middle
+            first[count + 1], last[count + 1] = middle, last[node]
+            count += 2
+    for node in range(count - 1, -1, -1):  # children before their parents
+        if left[node] < 0:
+            start, stop = first[node] * leaf_size, min(n, last[node] * leaf_size)
+            for c in range(3):
+                lower[node, c] = points[start, c]
+                upper[node, c] = points[start, c]
+            for j in range(start + 1, stop):
+                for c in range(3):
+                    lower[node, c] = min(lower[node, c], points[j, c])
+                    upper[node, c] = max(upper[node, c], points[j, c])
+        else:
+            for c in range(3):
+                lower[node, c] = min(lower[left[node], c], lower[right[node], c])
+                upper[node, c] = max(upper[left[node], c], upper[right[node], c])
+    return first[:count], last[:count], left[:count], right[:count], lower[:count], upper[:count]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _offer_rows(points, q, a, row_from, row_to, skip_self, k, best_d, best_i, found):
+    """Offer the sorted rows ``row_from..row_to-1`` to query ``q``'s sorted best-k list (slot ``a``)."""
+    qx, qy, qz = points[q, 0], points[q, 1], points[q, 2]
+    for j in range(row_from, row_to):
+        if skip_self and j == q:
+            continue
+        dx, dy, dz = points[j, 0] - qx, points[j, 1] - qy, points[j, 2] - qz
+        d = dx * dx + dy * dy + dz * dz
+        if found[a] == k and d >= best_d[a, k - 1]:
+            continue
+        pos = found[a] if found[a] < k else k - 1
+        while pos > 0 and best_d[a, pos - 1] > d:
+            best_d[a, pos] = best_d[a, pos - 1]
+            best_i[a, pos] = best_i[a, pos - 1]
+            pos -= 1
+        best_d[a, pos] = d
+        best_i[a, pos] = j
+        if found[a] < k:
+            found[a] += 1
+
+
+# What _knn_leaves does with each query's k nearest, once found.
+LISTS, MEAN_DISTANCE, NORMAL = 0, 1, 2
+
+
+@njit(cache=True, nogil=True)
+def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, right, lower, upper, mode,
+                leaf_from, leaf_to, out_d, out_i, out_normal, out_value):
+    """k nearest neighbours of the points of leaves ``leaf_from..leaf_to-1``, a leaf at a time.
+
+    Phase 1 offers each query the rows around its leaf (k on either side):
+    the largest k-th distance found, ``R``, bounds every query of the leaf.
+    Phase 2 walks the tree once for the whole leaf and offers only the leaves
+    whose box is within ``R`` of the leaf's box (and, per query, within its
+    own current k-th distance). A point outside those boxes is farther than
+    ``R`` from every query of the leaf, so the lists are exact.
+
+    ``mode`` says what to keep: the lists (``out_d``: squared distances,
+    ``out_i``), the mean distance (``out_value``), or the normal and
+    curvature of the neighbourhood (``out_normal``, ``out_value``), computed
+    while the neighbours are still in cache. Rows are in sorted order.
+    """
+    n = points.shape[0]
+    best_d = np.empty((leaf_size, k))
+    best_i = np.empty((leaf_size, k), dtype=np.int64)
+    found = np.zeros(leaf_size, dtype=np.int64)
+    stack = np.empty(128, dtype=np.int64)
+    leaf_lower = np.empty(3)
+    leaf_upper = np.empty(3)
+    for leaf in range(leaf_from, leaf_to):
+        start, stop = leaf * leaf_size, min(n, (leaf + 1) * leaf_size)
+        r0, r1 = max(0, start - window), min(n, stop + window)
+        if r1 - r0 < k + 1:  # a tiny cloud: everything
+            r0, r1 = 0, n
+        radius_sq = 0.0
+        for c in range(3):
+            leaf_lower[c] = points[start, c]
+            leaf_upper[c] = points[start, c]
+        for a in range(stop - start):
+            q = start + a
+            for c in range(3):
+                leaf_lower[c] = min(leaf_lower[c], points[q, c])
+                leaf_upper[c] = max(leaf_upper[c], points[q, c])
+            found[a] = 0
+            _offer_rows(points, q, a, r0, r1, skip_self, k, best_d, best_i, found)
+            radius_sq = max(radius_sq, best_d[a, k - 1])
+        top = 0
+        stack[0] = 0
+        top = 1
+        while top > 0:
+            top -= 1
+            node = stack[top]
+            gap = 0.0
+            for c in range(3):
+                g = max(lower[node, c] - leaf_upper[c], 0.0, leaf_lower[c] - upper[node, c])
+                gap += g * g
+            if gap > radius_sq:
+                continue
+            if left[node] >= 0:
+                stack[top] = left[node]
+                stack[top + 1] = right[node]
+                top += 2
+                continue
+            b_from, b_to = first[node] * leaf_size, min(n, last[node] * leaf_size)
+            if b_from >= r0 and b_to <= r1:
+                continue  # offered in phase 1
+            for a in range(stop - start):
+                q = start + a
+                own = 0.0
+                for c in range(3):
+                    g = max(lower[node, c] - points[q, c], 0.0, points[q, c] - upper[node, c])
+                    own += g * g
+                if own > best_d[a, k - 1]:
+                    continue
+                # the part of the leaf outside the phase-1 rows
+                _offer_rows(points, q, a, b_from, min(b_to, r0), skip_self, k, best_d, best_i, found)
+                _offer_rows(points, q, a, max(b_from, r1), b_to, skip_self, k, best_d, best_i, found)
+        for a in range(stop - start):
+            q = start + a
+            if mode == LISTS:
+                for m in range(k):
+                    out_d[q, m] = best_d[a, m]
+                    out_i[q, m] = best_i[a, m]
+            elif mode == MEAN_DISTANCE:
+                total = 0.0
+                for m in range(k):
+                    total += np.sqrt(best_d[a, m])
+                out_value[q] = total / k
+            else:
+                out_normal[q, 0], out_normal[q, 1], out_normal[q, 2], out_value[q] = patch_normal(
+                    points, best_i[a], 0, k)
+
+
+def _run_leaves(xyz, k, skip_self, mode, leaf_size=LEAF_SIZE, window=None):
+    """Sort along the Z-order curve, build the leaf tree, run ``_knn_leaves``; outputs in sorted order."""
+    n = len(xyz)
+    order = morton_order(xyz)
+    points = np.ascontiguousarray(xyz[order])
+    hierarchy = _leaf_hierarchy(points, leaf_size)
+    n_leaves = (n + leaf_size - 1) // leaf_size
+    window = k if window is None else window
+    lists = mode == LISTS
+    out_d = np.empty((n, k) if lists else (0, 0))
+    out_i = np.empty((n, k) if lists else (0, 0), dtype=np.int64)
+    out_normal = np.empty((n if mode == NORMAL else 0, 3))
+    out_value = np.empty(0 if lists else n)
+    inputs = (points, leaf_size, k, skip_self, window, *hierarchy, mode)
+    _in_threads(_knn_leaves, n_leaves, inputs, (out_d, out_i, out_normal, out_value), grain=64)
+    return order, out_d, out_i, out_normal, out_value
+
+
+def leaf_knn(xyz, k, skip_self=False):
+    """Exact k nearest neighbours of every point of ``xyz`` among ``xyz``.
+
+    Parameters
+    ----------
+    xyz : ndarray, shape (N, 3)
+    k : int
+        ``1 <= k <= N`` (``N - 1`` with ``skip_self``).
+    skip_self : bool
+        Leave each point's own row out (its duplicates stay).
+
+    Returns
+    -------
+    distances : ndarray, shape (N, k)
+        Euclidean distances, ascending along each row.
+    indices : ndarray of int64, shape (N, k)
+        Among equidistant candidates at the k-th distance, which are kept is unspecified.
+    """
+    order, dist, index, _, _ = _run_leaves(xyz, k, skip_self, LISTS)
+    distances = np.empty_like(dist)
+    indices = np.empty_like(index)
+    distances[order] = np.sqrt(dist)
+    indices[order] = order[index]
+    return distances, indices
+
+
+def knn_mean_distance(xyz, k):
+    """Mean distance from every point to its k nearest *other* points (duplicates count, at 0)."""
+    order, _, _, _, mean = _run_leaves(xyz, k, True, MEAN_DISTANCE)
+    result = np.empty_like(mean)
+    result[order] = mean
+    return result
+
+
+def knn_normals(xyz, k):
+    """Normal and curvature of the k nearest points of every point, itself included (``k >= 3``)."""
+    order, _, _, normal, curvature = _run_leaves(xyz, k, False, NORMAL)
+    normals = np.empty_like(normal)
+    normals[order] = normal
+    curvatures = np.empty_like(curvature)
+    curvatures[order] = curvature
+    return normals, curvatures

@@ -6,7 +6,7 @@ import numbers
 import numpy as np
 from scipy.spatial import cKDTree
 
-from solutions._neighbors import grid_is_usable, grid_radius_count, kdtree
+from solutions._neighbors import grid_is_usable, grid_radius_count, kdtree, knn_mean_distance
 from pcl_course.validation import as_array, as_points, check_integer, check_positive
 
 
@@ -38,12 +38,7 @@ def statistical_outlier_removal(points, k, std_ratio):
         check_integer(k, "k", low=1)
         return np.zeros(0, dtype=bool)
     k = check_integer(k, "k", low=1, high=len(points) - 1)
-    xyz = points[:, :3]
-    distances, _ = kdtree(xyz).query(xyz, k=k + 1, workers=-1)
-    # The k + 1 nearest include the point itself at distance 0, or, if ties
-    # pushed it out, k + 1 duplicates all at distance 0: either way their sum
-    # is the sum over the k nearest others.
-    mean_distance = distances.reshape(len(xyz), k + 1).sum(axis=1) / k
+    mean_distance = knn_mean_distance(points[:, :3], k)
     threshold = mean_distance.mean() + std_ratio * mean_distance.std(ddof=1)
     return mean_distance <= threshold
 

@@ -4,7 +4,7 @@ import numpy as np
 
 from pcl_course.validation import as_array, as_points, check_integer, check_positive
 from solutions._kernels import normals_from_neighbourhoods
-from solutions._neighbors import kdtree
+from solutions._neighbors import kdtree, knn_normals
 
 
 def fit_plane(points, weights=None):
@@ -21,6 +21,26 @@ def fit_plane(points, weights=None):
     scatter = (centred * weights[:, None]).T @ centred
     normal = np.linalg.eigh(scatter)[1][:, 0]
     return centroid, normal
+
+
+def _radius_normals(points, k, radius):
+    """Normals of the neighbourhoods within ``radius`` (the ``k`` nearest of them unless k is None)."""
+    n = len(points)
+    # Neighbourhoods in compressed form: point i's are members[offsets[i]:offsets[i+1]].
+    tree = kdtree(points)
+    if k is not None:
+        kk = min(k, n)
+        distances, indices = tree.query(points, k=kk, workers=-1)
+        # rows are sorted by distance: the ones within the radius are a prefix
+        within = distances.reshape(n, kk) <= radius
+        members, counts = indices.reshape(n, kk)[within], within.sum(axis=1)
+    else:
+        lists = tree.query_ball_point(points, r=radius, workers=-1)
+        counts = np.fromiter((len(row) for row in lists), dtype=np.int64, count=n)
+        members = np.concatenate(lists)
+    offsets = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(counts, out=offsets[1:])
+    return normals_from_neighbourhoods(points, members.astype(np.int64), offsets)
 
 
 def estimate_normals(points, k=30, radius=None, viewpoint=None):
@@ -41,24 +61,13 @@ def estimate_normals(points, k=30, radius=None, viewpoint=None):
     if n == 0:
         return np.empty((0, 3)), np.empty(0)
 
-    # Neighbourhoods in compressed form: point i's are members[offsets[i]:offsets[i+1]].
-    tree = kdtree(points)
-    if radius is None or k is not None:
-        kk = min(k, n)
-        distances, indices = tree.query(points, k=kk, workers=-1)
-        indices = indices.reshape(n, kk)
-        if radius is None:
-            members, counts = indices.reshape(-1), np.full(n, kk)
-        else:  # rows are sorted by distance: the ones within the radius are a prefix
-            within = distances.reshape(n, kk) <= radius
-            members, counts = indices[within], within.sum(axis=1)
+    if radius is None:
+        if k < 3:  # every neighbourhood is too small for a plane
+            return np.full((n, 3), np.nan), np.full(n, np.nan)
+        # k nearest: search and plane fit fused, on both cores.
+        normals, curvature = knn_normals(points, k)
     else:
-        lists = tree.query_ball_point(points, r=radius, workers=-1)
-        counts = np.fromiter((len(row) for row in lists), dtype=np.int64, count=n)
-        members = np.concatenate(lists)
-    offsets = np.zeros(n + 1, dtype=np.int64)
-    np.cumsum(counts, out=offsets[1:])
-    normals, curvature = normals_from_neighbourhoods(points, members.astype(np.int64), offsets)
+        normals, curvature = _radius_normals(points, k, radius)
     if viewpoint is not None:
         flip = np.einsum("ij,ij->i", normals, viewpoint - points) < 0
         normals[flip] *= -1.0

@@ -5,7 +5,8 @@ each optimisation where it could go wrong: the bucket-pruned farthest point
 sampling must pick the *same* indices as the plain loop (ties included), the
 voxel filters' three grouping strategies and the compiled hash table must
 group exactly as the plain versions, the closed-form eigensolver must match
-LAPACK on flat, linear, isotropic and badly scaled matrices, the grid radius
+LAPACK on flat, linear, isotropic and badly scaled matrices, the Z-order
+leaf search must find the k-d tree's neighbour distances, the grid radius
 count must equal the k-d tree's count at exactly the radius, and the Lanczos
 path of kernel PCA must match the dense solver.
 """
@@ -13,10 +14,11 @@ path of kernel PCA must match the dense solver.
 import numpy as np
 import plain  # tests/project/plain.py
 import pytest
+from scipy.spatial import cKDTree
 
 from solutions import downsampling, filters, normals, pca
 from solutions._kernels import hash_groups, smallest_eigenpair
-from solutions._neighbors import grid_is_usable, grid_radius_count
+from solutions._neighbors import grid_is_usable, grid_radius_count, leaf_knn
 
 RNG = np.random.default_rng(20261122)
 
@@ -189,6 +191,31 @@ def test_estimate_normals_matches_the_plain_eigh(name, k, radius):
     np.testing.assert_array_equal(np.isfinite(result_curvature), finite)
     np.testing.assert_allclose(np.abs(np.sum(result_normals[finite] * expected_normals[finite], axis=1)), 1.0, atol=1e-8)
     np.testing.assert_allclose(result_curvature[finite], expected_curvature[finite], rtol=1e-9, atol=1e-12)
+
+
+# --- k nearest neighbours: Z-order leaves vs the k-d tree ---------------------------------
+
+
+@pytest.mark.parametrize("name", sorted(CLOUDS))
+@pytest.mark.parametrize("k, skip_self", [(1, False), (1, True), (7, True), (30, False)])
+def test_leaf_knn_finds_the_kdtree_distances(name, k, skip_self):
+    points = CLOUDS[name]
+    distances, indices = leaf_knn(points, k, skip_self)
+    expected, _ = cKDTree(points).query(points, k=k + 1)
+    expected = expected[:, 1:] if skip_self else expected[:, :k]
+    # Equal distances; the indices are points at those distances, no repeats,
+    # never the query itself when skipped (ties at the k-th may pick others).
+    np.testing.assert_allclose(distances, expected, rtol=0, atol=1e-12 * float(np.abs(points).max()))
+    np.testing.assert_allclose(np.linalg.norm(points[indices] - points[:, None, :], axis=2), distances, atol=1e-9)
+    assert all(len(set(row)) == k for row in indices.tolist())
+    if skip_self:
+        assert not np.any(indices == np.arange(len(points))[:, None])
+
+
+def test_leaf_knn_on_a_cloud_smaller_than_a_leaf():
+    points = RNG.random((5, 3))
+    distances, _ = leaf_knn(points, 4, skip_self=True)
+    np.testing.assert_allclose(distances, cKDTree(points).query(points, k=5)[0][:, 1:])
 
 
 # --- filters ---------------------------------------------------------------------------
