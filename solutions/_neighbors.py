@@ -1,26 +1,29 @@
-"""Fast exact neighbour queries for the references: a tuned k-d tree and grid radius counting.
+"""Fast exact neighbour queries for the references (numba, both cores).
 
-``kdtree`` builds SciPy's ``cKDTree`` with the settings measured fastest
-for the all-points queries of normal estimation and outlier removal: an
-unbalanced tree (split at the midpoint of the bounding box, cheaper to
-build and as good to query on scans) with 32 points per leaf.
+**k nearest neighbours of every point** (normals, statistical filter). The
+points are sorted along a Z-order (Morton) curve and cut into leaves of 32
+consecutive points, with a binary tree of bounding boxes over the leaves.
+Each leaf is processed as a whole: its queries first see the rows around
+the leaf, which bounds every one of their k-th distances by some ``R``; one
+walk of the tree then finds the leaves within ``R`` of the leaf's box, and
+only those are offered to the queries. A k-d tree (SciPy's ``cKDTree``,
+Open3D's nanoflann) walks the tree once per *query*. The neighbour lists are
+consumed in place (plane fit, mean distance) while still in cache: no
+``(N, k)`` arrays.
 
-Exact fixed-radius neighbour counting on a uniform grid, compiled with numba:
-
-Radius outlier removal asks one question of every point: how many points lie
-within ``r``? A k-d tree answers one query at a time, descending the tree
-and backtracking; here the points are sorted once by the cell of a grid of
-side ``r``, so all of a query's neighbours lie in its 3 x 3 x 3 block of
-cells, which is nine contiguous runs of the sorted array (cells adjacent
+**Fixed-radius counts** (radius filter). The points are sorted by the cell
+of a grid of side ``r``: all of a query's neighbours lie in its 3 x 3 x 3
+block of cells, nine contiguous runs of the sorted array (cells adjacent
 along x are adjacent in the sort), and consecutive queries, in cell order,
-touch the same memory. The count is exact, not approximate.
+touch the same memory.
 
-(A grid k-nearest-neighbour search was measured too and dropped: on the
-uniform cube it only tied ``cKDTree.query``, and on the lidar scan, whose
-density varies a hundredfold with range, it was 30 % slower. See
-``benchmarks/README.md``.)
+Both are exact: the tests compare them with ``cKDTree``. (A grid k-nearest
+search was tried and dropped: one cell size cannot suit the lidar scan,
+whose density varies a hundredfold with range. See ``benchmarks/README.md``.)
 
-The queries are split between the cores in threads: numba releases the GIL.
+``kdtree`` builds SciPy's ``cKDTree`` with the settings measured fastest for
+the radius-limited normal estimation: unbalanced (midpoint splits), 32
+points per leaf. The queries run in threads: numba releases the GIL.
 """
 
 import os
