@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.linalg import eigh
 from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
-from scipy.spatial.distance import cdist
+from scipy.spatial.distance import cdist, pdist, squareform
 
 from pcl_course.validation import as_array, as_points, check_choice, check_integer, check_positive
 
@@ -48,6 +48,23 @@ def kernel_matrix(x, y, kernel="gaussian", beta=1.0, degree=2):
     gram = cdist(x, y, metric=metric)
     gram *= -beta  # in place: no N x M temporaries
     return np.exp(gram, out=gram)
+
+
+def _self_gram(points, kernel, beta, degree):
+    """``kernel_matrix(points, points, ...)``; for the distance kernels, each pair computed once.
+
+    The Gram matrix of a cloud with itself is symmetric with ones on the
+    diagonal: ``pdist`` and half the exponentials, mirrored by ``squareform``.
+    """
+    check_choice(kernel, "kernel", KERNELS)
+    if kernel not in ("gaussian", "laplacian"):
+        return kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
+    beta = check_positive(beta, "beta")
+    pairs = pdist(points, metric="sqeuclidean" if kernel == "gaussian" else "cityblock")
+    pairs *= -beta
+    gram = squareform(np.exp(pairs, out=pairs))
+    np.fill_diagonal(gram, 1.0)
+    return gram
 
 
 def _centring_terms(gram):
@@ -95,7 +112,7 @@ def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
     points = as_points(points, min_columns=1, allow_empty=False)
     n = points.shape[0]
     n_components = check_integer(n_components, "n_components", low=1, high=n)
-    gram = kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
+    gram = _self_gram(points, kernel, beta, degree)
     eigenvalues, eigenvectors = _top_eigenpairs(gram, n_components)
     positive = eigenvalues > 0
     scale = np.zeros_like(eigenvalues)
