@@ -96,7 +96,8 @@ def _student_config(text):
 
 
 def _student_pyproject(text):
-    text = text.replace('packages = ["pcl_course", "solutions", "grading"]', 'packages = ["pcl_course", "grading"]')
+    # The student package and the grader only: no reference, no benchmark harness.
+    text = re.sub(r'packages = \[[^\]]*\]', 'packages = ["pcl_course", "grading"]', text)
     return re.sub(r'testpaths = \[[^\]]*\]', 'testpaths = ["tests/graded"]', text)
 
 
