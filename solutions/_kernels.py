@@ -246,6 +246,20 @@ def _eigenvector(a00, a01, a02, a11, a12, a22, value):
 
 
 @njit(cache=True, inline="always")
+def _perpendicular(a, b):
+    """Unit vector perpendicular to ``(a, b)`` (up to sign), without overflow; ``(1, 0)`` for zero."""
+    if abs(a) >= abs(b):
+        if a == 0.0:
+            return 1.0, 0.0
+        t = b / a
+        s = 1.0 / np.sqrt(1.0 + t * t)
+        return t * s, -s
+    t = a / b
+    s = 1.0 / np.sqrt(1.0 + t * t)
+    return s, -t * s
+
+
+@njit(cache=True, inline="always")
 def _second_eigenvector(a00, a01, a02, a11, a12, a22, w, value):
     """Eigenvector of ``value`` orthogonal to the unit eigenvector ``w``: a 2x2 problem in w's complement."""
     if abs(w[0]) > abs(w[1]):
@@ -260,31 +274,11 @@ def _second_eigenvector(a00, a01, a02, a11, a12, a22, w, value):
     m00 = u[0] * au[0] + u[1] * au[1] + u[2] * au[2] - value
     m01 = u[0] * av[0] + u[1] * av[1] + u[2] * av[2]
     m11 = v[0] * av[0] + v[1] * av[1] + v[2] * av[2] - value
-    # Null vector (c_u, c_v) of [[m00, m01], [m01, m11]], normalised without overflow.
+    # Null vector (c_u, c_v) of [[m00, m01], [m01, m11]]: perpendicular to its larger row.
     if abs(m00) >= abs(m11):
-        if max(abs(m00), abs(m01)) == 0.0:
-            return u
-        if abs(m00) >= abs(m01):
-            m01 /= m00
-            m00 = 1.0 / np.sqrt(1.0 + m01 * m01)
-            m01 *= m00
-        else:
-            m00 /= m01
-            m01 = 1.0 / np.sqrt(1.0 + m00 * m00)
-            m00 *= m01
-        cu, cv = m01, -m00
+        cu, cv = _perpendicular(m00, m01)
     else:
-        if max(abs(m11), abs(m01)) == 0.0:
-            return u
-        if abs(m11) >= abs(m01):
-            m01 /= m11
-            m11 = 1.0 / np.sqrt(1.0 + m01 * m01)
-            m01 *= m11
-        else:
-            m11 /= m01
-            m01 = 1.0 / np.sqrt(1.0 + m11 * m11)
-            m11 *= m01
-        cu, cv = m11, -m01
+        cu, cv = _perpendicular(m01, m11)
     return (cu * u[0] + cv * v[0], cu * u[1] + cv * v[1], cu * u[2] + cv * v[2])
 
 

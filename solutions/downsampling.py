@@ -4,6 +4,7 @@ import numpy as np
 
 from pcl_course.validation import as_points, check_choice, check_integer, check_positive, check_rng
 from solutions._kernels import axis_bounds, bucket_fps, hash_groups, hash_table_filter, reservoir_choice, voxel_keys
+from solutions._neighbors import morton_order
 
 METHODS = ("centroid", "random")
 FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
@@ -132,22 +133,6 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
     return rows if centroid else points[chosen]
 
 
-def _morton_order(xyz, bits=10):
-    """Indices that sort the points along a Z-order curve (nearby points, nearby ranks)."""
-    lower, upper = axis_bounds(xyz)
-    span = float((upper - lower).max()) or 1.0
-    cells = np.minimum((xyz - lower) / span * (1 << bits), (1 << bits) - 1).astype(np.uint64)
-
-    def spread(v):  # insert two zero bits between the bits of a 10-bit integer
-        v = (v | (v << np.uint64(16))) & np.uint64(0x30000FF)
-        v = (v | (v << np.uint64(8))) & np.uint64(0x300F00F)
-        v = (v | (v << np.uint64(4))) & np.uint64(0x30C30C3)
-        return (v | (v << np.uint64(2))) & np.uint64(0x9249249)
-
-    code = spread(cells[:, 0]) | (spread(cells[:, 1]) << np.uint64(1)) | (spread(cells[:, 2]) << np.uint64(2))
-    return np.argsort(code, kind="stable")
-
-
 def farthest_point_sampling(points, n_samples, start_index=0):
     points = as_points(points)
     n = len(points)
@@ -156,7 +141,7 @@ def farthest_point_sampling(points, n_samples, start_index=0):
         return np.empty(0, dtype=np.int64)
     start_index = check_integer(start_index, "start_index", low=0, high=n - 1)
     xyz = points[:, :3]
-    order = _morton_order(xyz).astype(np.int64)
+    order = morton_order(xyz).astype(np.int64)  # buckets of consecutive points are compact
     position = np.empty(n, dtype=np.int64)
     position[order] = np.arange(n)
     x, y, z = (np.ascontiguousarray(xyz[order, axis]) for axis in range(3))
