@@ -1,6 +1,7 @@
 """The benchmark harness runs, alternates, reports; the committed results cover every target."""
 
 import json
+import os
 import subprocess
 import sys
 
@@ -23,8 +24,12 @@ def small_run(tmp_path_factory):
         "--bench-sizes=1500", "--bench-kernel-sizes=200", "--bench-datasets=cube,scan", "--bench-blocks=2",
         "--bench-block-seconds=0.005", f"--benchmark-json={out / 'raw.json'}", "--benchmark-save-data",
     ]
-    run = subprocess.run(command, cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+    # A clean environment: under pytest-xdist the PYTEST_* variables of the
+    # worker would make pytest-benchmark disable itself in the child.
+    env = {key: value for key, value in os.environ.items() if not key.startswith("PYTEST_")}
+    run = subprocess.run(command, cwd=REPO_ROOT, capture_output=True, text=True, timeout=600, env=env)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
+    assert (out / "raw.json").is_file(), run.stdout[-3000:]
     report = subprocess.run([sys.executable, "-m", "benchmarks.report", str(out / "raw.json"), str(out / "results")],
                             cwd=REPO_ROOT, capture_output=True, text=True, timeout=120)
     assert report.returncode == 0, report.stderr
