@@ -196,15 +196,15 @@ def _leaf_hierarchy(points, leaf_size):
     upper = np.empty((size, 3))
     first[0], last[0] = 0, n_leaves
     count = 1
-    for node in range(size):  # parents come before their children
-        if node >= count:
-            break
+    node = 0
+    while node < count:  # parents come before their children
         if last[node] - first[node] > 1:
             middle = (first[node] + last[node]) // 2
             left[node], right[node] = count, count + 1
             first[count], last[count] = first[node], middle
             first[count + 1], last[count + 1] = middle, last[node]
             count += 2
+        node += 1
     for node in range(count - 1, -1, -1):  # children before their parents
         if left[node] < 0:
             start, stop = first[node] * leaf_size, min(n, last[node] * leaf_size)
@@ -268,6 +268,23 @@ def _offer_rows(points, q, a, row_from, row_to, skip_self, k, best_d, best_i, fo
             heap_i[pos] = j
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _box_gap_sq(lower, upper, node, points, q):
+    """Squared distance from point ``q`` to the bounding box of ``node`` (0 inside)."""
+    gap = 0.0
+    for c in range(3):
+        g = max(lower[node, c] - points[q, c], 0.0, points[q, c] - upper[node, c])
+        gap += g * g
+    return gap
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _offer_outside(points, q, a, b_from, b_to, r0, r1, skip_self, k, best_d, best_i, found):
+    """Offer the rows ``b_from..b_to-1`` except the phase-1 rows ``r0..r1-1`` (already offered)."""
+    _offer_rows(points, q, a, b_from, min(b_to, r0), skip_self, k, best_d, best_i, found)
+    _offer_rows(points, q, a, max(b_from, r1), b_to, skip_self, k, best_d, best_i, found)
+
+
 # What _knn_leaves does with each query's k nearest, once found.
 LISTS, MEAN_DISTANCE, NORMAL = 0, 1, 2
 
@@ -305,7 +322,6 @@ def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, righ
         r0, r1 = max(0, start - window), min(n, stop + window)
         if r1 - r0 < k + 1:  # a tiny cloud: everything
             r0, r1 = 0, n
-        radius_sq = 0.0
         for c in range(3):
             leaf_lower[c] = points[start, c]
             leaf_upper[c] = points[start, c]
@@ -328,7 +344,6 @@ def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, righ
             alone[a] = phase_one[a] > limit
             if not alone[a]:
                 radius_sq = max(radius_sq, phase_one[a])
-        top = 0
         stack[0] = 0
         top = 1
         while top > 0:
@@ -352,15 +367,8 @@ def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, righ
                 if alone[a]:
                     continue
                 q = start + a
-                own = 0.0
-                for c in range(3):
-                    g = max(lower[node, c] - points[q, c], 0.0, points[q, c] - upper[node, c])
-                    own += g * g
-                if own > best_d[a, 0]:
-                    continue
-                # the part of the leaf outside the phase-1 rows
-                _offer_rows(points, q, a, b_from, min(b_to, r0), skip_self, k, best_d, best_i, found)
-                _offer_rows(points, q, a, max(b_from, r1), b_to, skip_self, k, best_d, best_i, found)
+                if _box_gap_sq(lower, upper, node, points, q) <= best_d[a, 0]:
+                    _offer_outside(points, q, a, b_from, b_to, r0, r1, skip_self, k, best_d, best_i, found)
         for a in range(m):
             if not alone[a]:
                 continue
@@ -371,11 +379,7 @@ def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, righ
             while top > 0:
                 top -= 1
                 node = stack[top]
-                own = 0.0
-                for c in range(3):
-                    g = max(lower[node, c] - points[q, c], 0.0, points[q, c] - upper[node, c])
-                    own += g * g
-                if own > best_d[a, 0]:
+                if _box_gap_sq(lower, upper, node, points, q) > best_d[a, 0]:
                     continue
                 if left[node] >= 0:
                     stack[top] = left[node]
@@ -383,8 +387,7 @@ def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, righ
                     top += 2
                     continue
                 b_from, b_to = first[node] * leaf_size, min(n, last[node] * leaf_size)
-                _offer_rows(points, q, a, b_from, min(b_to, r0), skip_self, k, best_d, best_i, found)
-                _offer_rows(points, q, a, max(b_from, r1), b_to, skip_self, k, best_d, best_i, found)
+                _offer_outside(points, q, a, b_from, b_to, r0, r1, skip_self, k, best_d, best_i, found)
         for a in range(stop - start):
             q = start + a
             if mode == LISTS:  # ascending, as a k-d tree returns them

@@ -10,15 +10,19 @@ METHODS = ("centroid", "random")
 FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
 
 
-def voxel_coordinates(xyz, voxel_size):
-    """Per-axis voxel coordinates ``h`` (int64, shape (N, 3)) and grid sizes ``D`` (Python ints).
+def voxel_grid(xyz, voxel_size):
+    """Grid origin (per-axis minimum, shape (3,)) and grid sizes ``D`` (a tuple of Python ints).
 
-    ``D`` stays a tuple of Python ints so that products of it never overflow.
+    ``D`` stays Python ints so that products of it never overflow.
     """
     lower, upper = axis_bounds(xyz)
-    h = np.floor((xyz - lower) / voxel_size).astype(np.int64)
-    dims = tuple(int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
-    return h, dims
+    return lower, tuple(int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
+
+
+def voxel_coordinates(xyz, voxel_size):
+    """Per-axis voxel coordinates ``h`` (int64, shape (N, 3)) and grid sizes ``D`` (Python ints)."""
+    lower, dims = voxel_grid(xyz, voxel_size)
+    return np.floor((xyz - lower) / voxel_size).astype(np.int64), dims
 
 
 def _group_sorted(h):
@@ -55,8 +59,7 @@ def voxel_groups(xyz, voxel_size):
     keys are sorted. Beyond int64 the coordinates are sorted
     lexicographically (three keys, slowest, exact).
     """
-    lower, upper = axis_bounds(xyz)
-    dims = tuple(int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
+    lower, dims = voxel_grid(xyz, voxel_size)
     n_cells = dims[0] * dims[1] * dims[2]  # Python ints: never overflows
     if n_cells > np.iinfo(np.int64).max:
         h, _ = voxel_coordinates(xyz, voxel_size)
@@ -107,8 +110,7 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
         return np.empty((0, points.shape[1]))
     m = n_containers
     xyz = points[:, :3]
-    lower, upper = axis_bounds(xyz)
-    dx, dy, dz = (int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
+    lower, (dx, dy, dz) = voxel_grid(xyz, voxel_size)
     n_cells = dx * dy * dz  # Python ints: exact
     if m >= n_cells:
         # Every voxel has a container of its own (its linear index), and

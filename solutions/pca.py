@@ -8,6 +8,7 @@ from scipy.spatial.distance import cdist, pdist, squareform
 from pcl_course.validation import as_array, as_points, check_choice, check_integer, check_positive
 
 KERNELS = ("linear", "polynomial", "gaussian", "laplacian")
+DISTANCES = {"gaussian": "sqeuclidean", "laplacian": "cityblock"}  # exp(-beta * distance) kernels
 
 
 def pca(points, correlation=False, sort=True):
@@ -44,10 +45,13 @@ def kernel_matrix(x, y, kernel="gaussian", beta=1.0, degree=2):
         degree = check_integer(degree, "degree", low=1)
         return (1.0 + x @ y.T) ** degree
     beta = check_positive(beta, "beta")
-    metric = "sqeuclidean" if kernel == "gaussian" else "cityblock"
-    gram = cdist(x, y, metric=metric)
-    gram *= -beta  # in place: no N x M temporaries
-    return np.exp(gram, out=gram)
+    return _exp_kernel(cdist(x, y, metric=DISTANCES[kernel]), beta)
+
+
+def _exp_kernel(distances, beta):
+    """``exp(-beta * distances)``, in place: no further N x M temporaries."""
+    distances *= -beta
+    return np.exp(distances, out=distances)
 
 
 def _self_gram(points, kernel, beta, degree):
@@ -56,13 +60,10 @@ def _self_gram(points, kernel, beta, degree):
     The Gram matrix of a cloud with itself is symmetric with ones on the
     diagonal: ``pdist`` and half the exponentials, mirrored by ``squareform``.
     """
-    check_choice(kernel, "kernel", KERNELS)
-    if kernel not in ("gaussian", "laplacian"):
+    if kernel not in DISTANCES:
         return kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
     beta = check_positive(beta, "beta")
-    pairs = pdist(points, metric="sqeuclidean" if kernel == "gaussian" else "cityblock")
-    pairs *= -beta
-    gram = squareform(np.exp(pairs, out=pairs))
+    gram = squareform(_exp_kernel(pdist(points, metric=DISTANCES[kernel]), beta))
     np.fill_diagonal(gram, 1.0)
     return gram
 
