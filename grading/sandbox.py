@@ -27,6 +27,7 @@ import secrets
 import select
 import shutil
 import signal
+import stat
 import struct
 import subprocess
 import sys
@@ -60,6 +61,19 @@ def _limits(unprivileged):
         if unprivileged:
             resource.setrlimit(resource.RLIMIT_NPROC, (PROCESS_LIMIT, PROCESS_LIMIT))
     return apply
+
+
+def _make_reachable(path):
+    """Let the unprivileged worker reach ``path``: search permission (o+x) on its ancestors.
+
+    A clone in a private directory (``mktemp -d`` is mode 0700) would hide
+    the virtual environment's packages from ``nobody``. Search permission
+    alone lets it pass through a directory without listing it.
+    """
+    for parent in Path(path).resolve().parents:
+        mode = parent.stat().st_mode
+        if not mode & stat.S_IXOTH:
+            os.chmod(parent, stat.S_IMODE(mode) | stat.S_IXOTH)
 
 
 def _become_subreaper():
@@ -138,6 +152,7 @@ class Worker:
                         ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
         shutil.copy(WORKER, Path(self.work) / WORKER.name)  # readable wherever the grader lives
         if self.isolated:
+            _make_reachable(Path(sys.prefix) / "lib")  # the environment's packages
             for path in [Path(self.work), *Path(self.work).rglob("*")]:
                 os.chown(path, NOBODY, NOBODY)
         self.stderr = tempfile.TemporaryFile()
