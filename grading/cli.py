@@ -23,28 +23,33 @@ import argparse
 import csv
 import json
 import os
+import queue
 import subprocess
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from grading import GRADED_FUNCTIONS, GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT
+from grading import GRADED_FUNCTIONS, GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT, config
 
 PYTEST_EXIT_NO_TESTS = 5
 
 
 def find_package(submission):
-    """The exercise folder of a submission: ``DIR/pcl_course`` or ``DIR`` itself."""
-    submission = Path(submission).resolve()
+    """The exercise folder of a submission: ``DIR/pcl_course`` or ``DIR`` itself.
+
+    Symbolic links are not followed here: staging (grading/staging.py)
+    refuses a linked ``pcl_course`` with one clear line.
+    """
+    submission = Path(os.path.abspath(submission))
     for candidate in (submission / "pcl_course", submission):
-        if candidate.name == "pcl_course" and (candidate / "__init__.py").is_file():
+        if candidate.name == "pcl_course" and os.path.lexists(candidate):
             return candidate
     raise SystemExit(f"error: no pcl_course/ package found in {submission}")
 
 
 def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), tests=None, sandbox=False,
-                     call_timeout=None):
+                     call_timeout=None, require_isolation=False, sandbox_uid=None):
     """Run the graded tests on ``impl_dir``; return pytest's exit code."""
     if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
         tests = [d for d in (GRADED_TESTS, HIDDEN_TESTS) if d.is_dir()]
@@ -61,6 +66,10 @@ def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), 
         command += ["--impl-module", override]
     if sandbox:
         command.append("--sandbox")
+    if require_isolation:
+        command.append("--require-isolation")
+    if sandbox_uid is not None:
+        command += ["--sandbox-uid", str(sandbox_uid)]
     if call_timeout:
         command += ["--call-timeout", str(call_timeout)]
     if keyword:
@@ -86,6 +95,8 @@ def format_report(summary, title):
         )
         lines.extend(" " * (width + 17) + "  " + line for line in output[1:])
     lines += ["", f"Total: {summary['score']:g} / {summary['max_score']:g}"]
+    if summary.get("output"):
+        lines.append(summary["output"])
     return "\n".join(lines)
 
 
@@ -100,8 +111,16 @@ def grade(args):
     # The reference and the project's own wrong submissions are trusted code;
     # a student's submission runs in the sandbox.
     sandbox = not args.reference and not args.impl_module
+    if sandbox and args.require_isolation:
+        from grading.sandbox import isolation
+
+        level = isolation()
+        if not level.isolated:
+            print(f"error: refusing to grade: the submission could not be isolated ({level.reason})",
+                  file=sys.stderr)
+            return 1
     code, output = run_graded_tests(impl_dir, results, args.k, args.junit, args.impl_module, sandbox=sandbox,
-                                    call_timeout=args.call_timeout)
+                                    call_timeout=args.call_timeout, require_isolation=args.require_isolation)
     if code == PYTEST_EXIT_NO_TESTS:
         print(f"error: no graded test matches -k {args.k!r}", file=sys.stderr)
         return 2
@@ -133,21 +152,42 @@ def points_per_function(summary):
 
 def batch(args):
     root = Path(args.directory).resolve()
-    submissions = sorted(p for p in root.iterdir() if (p / "pcl_course" / "__init__.py").is_file())
+    # lexists: a linked submission or pcl_course is listed, then refused by staging.
+    submissions = sorted(p for p in root.iterdir() if os.path.lexists(p / "pcl_course"))
     if not submissions:
         raise SystemExit(f"error: no subdirectory of {root} holds a pcl_course/ package")
     out = Path(args.out).resolve() if args.out else root.parent / f"{root.name}-results"
     out.mkdir(parents=True, exist_ok=True)
+    jobs = max(1, min(args.jobs or os.cpu_count() or 1, config.SANDBOX_UID_SLOTS))
+    require = not args.allow_unisolated
+    if require:
+        from grading.sandbox import isolation
+
+        level = isolation()
+        if not level.isolated:
+            raise SystemExit(f"error: refusing to grade the class: submissions could not be isolated "
+                             f"({level.reason}); --allow-unisolated grades anyway, as a local check")
+    # One dedicated sandbox uid per parallel slot: two submissions graded at
+    # once never share a uid, and whatever one left running is killed before
+    # its slot grades the next.
+    slots = queue.Queue()
+    for slot in range(jobs):
+        slots.put(config.SANDBOX_UID_BASE + slot)
 
     def grade_one(submission):
         results = out / f"{submission.name}.json"
-        code, output = run_graded_tests(submission / "pcl_course", results, args.k, sandbox=True)
+        uid = slots.get()
+        try:
+            code, output = run_graded_tests(submission / "pcl_course", results, args.k, sandbox=True,
+                                            require_isolation=require, sandbox_uid=uid)
+        finally:
+            slots.put(uid)
         if code not in (0, 1) or not results.exists():
             return submission.name, None, output
         return submission.name, json.loads(results.read_text()), output
 
     # Each grading is its own pytest process: threads only wait for them.
-    with ThreadPoolExecutor(max_workers=args.jobs or os.cpu_count() or 1) as pool:
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
         graded = list(pool.map(grade_one, submissions))
 
     functions = [f for f in GRADED_FUNCTIONS if any(r and f in points_per_function(r) for _, r, _ in graded)]
@@ -181,6 +221,9 @@ def main(argv=None):
     g.add_argument("--junit", help="also write JUnit XML here")
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
     g.add_argument("--call-timeout", type=float, help="seconds one call of a submission may take (default 30)")
+    g.add_argument("--require-isolation", action="store_true",
+                   help="refuse to grade unless the submission runs isolated (bubblewrap, or root with a "
+                        "dedicated uid); for official marks")
     g.add_argument("--require-full", action="store_true",
                    help="exit 1 unless every selected test passed (for GitHub Classroom steps)")
     g.add_argument("--impl-module", action="append", default=[], metavar="MODULE=FILE",
@@ -191,6 +234,8 @@ def main(argv=None):
     b.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
     b.add_argument("--jobs", type=int, help="submissions graded at once (default: number of cores)")
     b.add_argument("-k", help="select tests as pytest -k does")
+    b.add_argument("--allow-unisolated", action="store_true",
+                   help="grade even where submissions cannot be isolated (marks are then local checks)")
     r = commands.add_parser("release", help="write the student repository (no solutions, no hidden tests)")
     r.add_argument("out_dir", help="an empty or new folder")
     args = parser.parse_args(argv)

@@ -14,7 +14,8 @@ import ast
 from dataclasses import dataclass
 from pathlib import Path
 
-FORBIDDEN_PACKAGES = ("open3d", "sklearn", "pcl", "pclpy", "torch", "torch_cluster", "pytorch3d", "fpsample")
+from grading.config import FORBIDDEN_PACKAGES
+
 IMPORT_FUNCTIONS = {("builtins", "__import__"), ("importlib", "import_module"), ("importlib", "__import__")}
 
 
@@ -97,38 +98,68 @@ def scan_file(path):
 HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")
 
 
-def _local_imports(path, package_files):
-    """Names of the package's own modules that ``path`` imports."""
+def module_files(directory):
+    """Every module of a package folder, by dotted name relative to the package.
+
+    ``pca.py`` and ``pca/__init__.py`` are both module ``"pca"`` (Python
+    imports the package when both exist); ``sub/x.py`` is ``"sub.x"``; the
+    package's own ``__init__.py`` is ``"__init__"``.
+    """
+    directory = Path(directory)
+    files = {}
+    for path in sorted(directory.rglob("*.py")):
+        parts = list(path.relative_to(directory).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        files.setdefault(".".join(parts) or "__init__", []).append(path)
+    return files
+
+
+def _imported_names(path, name):
+    """Dotted names (relative to the package) that the module ``name`` at ``path`` may import."""
     try:
         tree = ast.parse(Path(path).read_text(encoding="utf-8", errors="replace"))
     except SyntaxError:
         return set()
+    package = name.split(".") if Path(path).name == "__init__.py" and name != "__init__" else name.split(".")[:-1]
+    if name == "__init__":
+        package = []
     names = set()
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom):
             module = node.module or ""
-            if node.level > 0 or module.split(".")[0] == "pcl_course":
-                parts = module.split(".")[1:] if module.startswith("pcl_course") else module.split(".")
-                names.update(p for p in parts[:1] if p)
-                names.update(alias.name for alias in node.names)
+            if node.level > 0:
+                base = package[: len(package) - (node.level - 1)] if node.level > 1 else package
+                target = base + [p for p in module.split(".") if p]
+            elif module.split(".")[0] == "pcl_course":
+                target = module.split(".")[1:]
+            else:
+                continue
+            names.add(".".join(target))
+            names.update(".".join([*target, alias.name]) for alias in node.names)
         elif isinstance(node, ast.Import):
             for alias in node.names:
                 parts = alias.name.split(".")
-                if parts[0] == "pcl_course" and len(parts) > 1:
-                    names.add(parts[1])
-    return names & set(package_files)
+                if parts[0] == "pcl_course":
+                    names.add(".".join(parts[1:]))
+    # Importing a.b.c runs a/__init__ and a/b/__init__ first.
+    return {".".join(n.split(".")[:i]) for n in names for i in range(1, n.count(".") + 2)} | {"__init__"}
 
 
 def scan_package(directory, trusted_directory=None, overrides=None):
     """Forbidden imports reachable from each module of a submission's package.
 
+    Every ``.py`` file under ``directory`` is read, subpackages included, so
+    that a package ``pca/`` standing where ``pca.py`` is expected is scanned
+    like the module it shadows.
+
     Parameters
     ----------
     directory : path
-        The submission's ``pcl_course/`` (or any folder of exercise modules).
+        The submission's (staged) ``pcl_course/``, or any folder of exercise modules.
     trusted_directory : path, optional
-        The grader's own ``pcl_course/``: a helper module identical to its
-        trusted copy is not scanned (the real ``datasets`` uses Open3D).
+        The grader's own ``pcl_course/``: a top-level helper module identical
+        to its trusted copy is not scanned (the real ``datasets`` uses Open3D).
     overrides : dict, optional
         Module name -> file replacing that module.
 
@@ -138,19 +169,22 @@ def scan_package(directory, trusted_directory=None, overrides=None):
         Module name -> list of :class:`Violation` in it or in the package's
         modules it imports, directly or not.
     """
-    directory = Path(directory)
-    files = {p.stem: p for p in directory.glob("*.py")}
-    files.update({name: Path(path) for name, path in (overrides or {}).items()})
+    files = module_files(directory)
+    files.update({name: [Path(path)] for name, path in (overrides or {}).items()})
     own = {}
-    for name, path in files.items():
-        trusted = Path(trusted_directory) / path.name if trusted_directory else None
-        pristine = (name in HELPER_MODULES and trusted is not None and trusted.exists()
-                    and trusted.read_bytes() == path.read_bytes())
-        own[name] = [] if pristine else scan_file(path)
-    graph = {name: _local_imports(path, files) for name, path in files.items()}
+    for name, paths in files.items():
+        own[name] = []
+        for path in paths:
+            trusted = Path(trusted_directory) / path.name if trusted_directory else None
+            pristine = (name in HELPER_MODULES and path.parent == Path(directory) and trusted is not None
+                        and trusted.exists() and trusted.read_bytes() == path.read_bytes())
+            if not pristine:
+                own[name].extend(scan_file(path))
+    graph = {name: {n for path in paths for n in _imported_names(path, name)} & set(files)
+             for name, paths in files.items()}
 
     def reachable(start):
-        seen, stack = set(), [start]
+        seen, stack = set(), [start, "__init__"]
         while stack:
             name = stack.pop()
             if name not in seen:
@@ -158,4 +192,5 @@ def scan_package(directory, trusted_directory=None, overrides=None):
                 stack.extend(graph.get(name, ()))
         return seen
 
-    return {name: [v for module in sorted(reachable(name)) for v in own[module]] for name in files}
+    return {name: [v for module in sorted(reachable(name)) if module in own for v in own[module]]
+            for name in files}

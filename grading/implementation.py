@@ -8,12 +8,15 @@ this repository stay what the tests use.
 
 import importlib.util
 import itertools
+import os
+import shutil
 import sys
 from pathlib import Path
 
 import numpy as np
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT
+from grading import GRADED_FUNCTIONS, REPO_ROOT, config
+from grading.errors import StagingError
 from grading.forbidden import scan_package
 
 _counter = itertools.count()
@@ -75,23 +78,38 @@ class Implementation:
         module of a wrong submission against the reference for the rest).
     """
 
-    def __init__(self, directory, overrides=None, sandbox=False, call_timeout=30.0):
-        self.directory = Path(directory).resolve()
+    def __init__(self, directory, overrides=None, sandbox=False, call_timeout=config.CALL_TIMEOUT,
+                 sandbox_uid=None):
+        self.directory = Path(directory).resolve() if not sandbox else Path(os.path.abspath(directory))
         self.overrides = {k: Path(v).resolve() for k, v in (overrides or {}).items()}
         self.package = f"_graded_impl_{next(_counter)}"
         self._modules = {}
         self.last_call = None
-        # Read before anything runs: a forbidden import costs the module's points.
-        self.violations = scan_package(self.directory, REPO_ROOT / "pcl_course", self.overrides)
         self.worker = None
+        self.staged = None
+        self.refusal = None
+        self.isolation = None
         if sandbox:
-            # The submission runs in a worker process, never in this one.
+            # The submission runs in a worker process, never in this one, on
+            # a copy staged by the grader: never where the student's files lie.
             from grading.sandbox import Worker
+            from grading.staging import stage
 
             if self.overrides or self.directory.name != "pcl_course":
                 raise ValueError("the sandbox grades a clone's pcl_course/ package, without overrides")
-            self.worker = Worker(self.directory.parent, timeout=call_timeout)
+            try:
+                self.staged = stage(self.directory)
+            except StagingError as exc:
+                self.refusal = StagingError(f"submission refused: {exc}")
+                self.violations = {}
+                return
+            scanned = self.staged.package
+            self.violations = scan_package(scanned, REPO_ROOT / "pcl_course")
+            self.worker = Worker(self.staged.root, timeout=call_timeout, uid=sandbox_uid)
+            self.isolation = self.worker.isolation
         else:
+            # Read before anything runs: a forbidden import costs the module's points.
+            self.violations = scan_package(self.directory, REPO_ROOT / "pcl_course", self.overrides)
             self._make_package()
 
     def _make_package(self):
@@ -125,8 +143,10 @@ class Implementation:
         module_name = GRADED_FUNCTIONS[name]
         if self.violations.get(module_name):
             raise ForbiddenAPI(module_name, self.violations[module_name])
+        if self.refusal is not None:
+            raise self.refusal
         if self.worker is not None:
-            if not (self.directory / f"{module_name}.py").is_file():
+            if not {f"{module_name}.py", f"{module_name}/__init__.py"} & set(self.staged.files):
                 raise StudentError(f"the submission has no module {module_name}.py")
 
             def function(*args, **kwargs):
@@ -149,3 +169,5 @@ class Implementation:
     def close(self):
         if self.worker is not None:
             self.worker.stop()
+        if self.staged is not None:
+            shutil.rmtree(self.staged.root, ignore_errors=True)

@@ -21,10 +21,13 @@ Markers
 """
 
 import json
+import os
 from pathlib import Path
 
 import pytest
 
+from grading import config as grading_config
+from grading.errors import SandboxError, StagingError
 from grading.implementation import ForbiddenAPI, Implementation, NotImplementedYet
 
 DEFAULT_TIMEOUT = 60.0  # seconds per graded test, ample for plain-loop solutions
@@ -44,8 +47,12 @@ def pytest_addoption(parser):
                     help="write the results (Gradescope JSON) to FILE")
     group.addoption("--sandbox", action="store_true",
                     help="run the implementation in a limited worker process (grading/sandbox.py)")
-    group.addoption("--call-timeout", type=float, default=30.0, metavar="SECONDS",
-                    help="wall-clock limit of one call in the sandbox (default 30)")
+    group.addoption("--call-timeout", type=float, default=grading_config.CALL_TIMEOUT, metavar="SECONDS",
+                    help=f"wall-clock limit of one call in the sandbox (default {grading_config.CALL_TIMEOUT:g})")
+    group.addoption("--sandbox-uid", type=int, default=None, metavar="UID",
+                    help="the dedicated uid that runs the submission when the grader is root")
+    group.addoption("--require-isolation", action="store_true",
+                    help="refuse to grade unless the submission runs isolated (bubblewrap or a dedicated uid)")
 
 
 def pytest_configure(config):
@@ -63,9 +70,22 @@ def _implementation(config):
             if not sep:
                 raise pytest.UsageError(f"--impl-module takes MODULE=FILE, got {item!r}")
             overrides[module] = path
-        config.stash[_IMPL_KEY] = Implementation(directory, overrides, sandbox=config.getoption("--sandbox"),
-                                                 call_timeout=config.getoption("--call-timeout"))
+        impl = Implementation(directory, overrides, sandbox=config.getoption("--sandbox"),
+                              call_timeout=config.getoption("--call-timeout"),
+                              sandbox_uid=config.getoption("--sandbox-uid"))
+        config.stash[_IMPL_KEY] = impl
+        if impl.isolation is not None and not impl.isolation.isolated and config.getoption("--require-isolation"):
+            impl.refusal = SandboxError(f"refusing to grade: the submission could not be isolated "
+                                        f"({impl.isolation.reason})")
     return config.stash[_IMPL_KEY]
+
+
+def isolation_note(config):
+    """One line on how the submission was isolated, or None when it ran in-process (trusted code)."""
+    impl = config.stash.get(_IMPL_KEY, None)
+    if impl is None or impl.isolation is None:
+        return None
+    return impl.isolation.describe()
 
 
 @pytest.fixture(scope="session")
@@ -102,10 +122,10 @@ def _feedback(excinfo, impl):
     """One short, readable explanation of a failure."""
     exc = excinfo.value
     last_call = f"\n  last call: {impl.last_call}" if impl and impl.last_call else ""
-    if isinstance(exc, (NotImplementedYet, ForbiddenAPI)):
+    if isinstance(exc, (NotImplementedYet, ForbiddenAPI, StagingError)):
         return str(exc)
     text = str(exc).strip()
-    if type(exc).__name__ == "SandboxError":
+    if isinstance(exc, SandboxError):
         return f"{text}{last_call}"
     if excinfo.typename == "Failed" and text.startswith("Timeout"):
         return f"timed out: {text.splitlines()[0]}{last_call}"
@@ -153,19 +173,23 @@ def pytest_runtest_makereport(item, call):
         if report.when != "call":
             message = f"error in test {report.when}: {message}"
         entry.update(score=0.0, status="failed", output=message)
-        if isinstance(call.excinfo.value if call.excinfo else None, (NotImplementedYet, ForbiddenAPI)):
+        if isinstance(call.excinfo.value if call.excinfo else None,
+                      (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError)):
             report.longrepr = message  # one line, not a traceback
     elif report.skipped and report.when != "teardown":
         entry.update(score=0.0, status="failed", output="skipped")
 
 
-def results_summary(results):
+def results_summary(results, isolation=None):
     tests = list(results.values())
-    return {
+    summary = {
         "score": sum(t["score"] for t in tests),
         "max_score": sum(t["max_score"] for t in tests),
         "tests": tests,
     }
+    if isolation is not None:
+        summary["output"] = isolation
+    return summary
 
 
 def pytest_unconfigure(config):
@@ -180,7 +204,10 @@ def pytest_sessionfinish(session, exitstatus):
     if path and not hasattr(session.config, "workerinput"):
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(json.dumps(results_summary(results), indent=2))
+        # Readable by the grader's user only: a submission never reads its feedback early.
+        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+        with os.fdopen(fd, "w") as handle:
+            handle.write(json.dumps(results_summary(results, isolation_note(session.config)), indent=2))
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
@@ -189,6 +216,9 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         return
     summary = results_summary(results)
     terminalreporter.write_sep("=", "marks")
+    note = isolation_note(config)
+    if note:
+        terminalreporter.write_line(note)
     for test in summary["tests"]:
         terminalreporter.write_line(
             f"{test['score']:5.1f} / {test['max_score']:<4.1f} {test['name']}"

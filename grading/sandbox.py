@@ -1,29 +1,50 @@
-"""Run a submission's functions in a separate, limited worker process.
+"""Run a staged submission's functions in a separate, isolated worker process.
 
 The grading process (which runs the tests and decides the score) never
 imports the submission. Each call is sent to a worker process
-(``grading/worker.py``) that
+(``grading/worker.py``) that runs at the strongest level of isolation the
+machine allows (:func:`isolation`):
 
-* runs under ``RLIMIT_AS`` (memory), ``RLIMIT_CPU`` and, as an unprivileged
-  user, ``RLIMIT_NPROC`` (fork bombs), in its own process group, with an
-  environment stripped to the essentials;
-* when the grader runs as root with util-linux's ``unshare`` and ``setpriv``,
-  runs as ``nobody`` in a private mount namespace where the reference
-  solutions and the tests are empty directories;
-* answers with plain data only: JSON plus an ``.npz`` read with
-  ``allow_pickle=False``. Nothing the worker produced is ever unpickled.
+``bubblewrap``
+    ``bwrap --unshare-all`` (user, pid, network, ipc, uts and cgroup
+    namespaces), ``--die-with-parent``, ``--new-session``, a cleared
+    environment, and a filesystem built from nothing: read-only binds of the
+    interpreter (``sys.base_prefix``), the system libraries, the
+    environment's site-packages with every forbidden package and every
+    editable-install file masked, the staged submission and the worker
+    script; a size-capped tmpfs for ``/tmp`` (also ``HOME``); its own
+    ``/proc`` and a minimal ``/dev``. No repository, ``.git``, tests,
+    solutions, ``grading/`` or other submission exists there.
+``uid``
+    No namespaces (a container that forbids them), but the grader is root:
+    the worker runs as a dedicated unprivileged uid (one per ``batch`` slot)
+    and the grader first checks, as that uid, that the course's tests,
+    solutions and ``.git`` cannot be read. Everything that uid left running
+    is killed after each worker.
+``none``
+    Neither: the worker runs as the grader's own user, with the resource
+    limits only. Grading still runs, but the result is a local check, not a
+    mark, and says so; ``--require-isolation`` refuses this level.
+
+At every level the worker runs under ``RLIMIT_AS``, ``RLIMIT_CPU``,
+``RLIMIT_FSIZE`` and, as its own user, ``RLIMIT_NPROC``, and answers with
+plain data only, over its stdout: JSON plus ``.npz`` bytes read with
+``allow_pickle=False``. The grader never opens a path the worker names and
+never unpickles what the worker sent.
 
 A call that times out, crashes the worker or returns something that is not
 plain data fails that call (and so that test); the next call starts a fresh
-worker.
+worker. A module that cannot be imported (it raises, exits, crashes or hangs
+at import) is detected once: every later call into it fails at once with
+the same message.
 """
 
 import builtins
+import io
 import json
 import os
 import pickle
 import resource
-import secrets
 import select
 import shutil
 import signal
@@ -33,47 +54,171 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
-from grading import REPO_ROOT
-from grading.forbidden import FORBIDDEN_PACKAGES
+from grading import REPO_ROOT, config
+from grading.errors import SandboxError
 
 WORKER = Path(__file__).with_name("worker.py")
-MEMORY_LIMIT = 4 * 1024**3      # bytes of address space
-CPU_LIMIT = 600                 # CPU seconds for a worker's whole life
-PROCESS_LIMIT = 256             # processes of the unprivileged user (fork bombs)
-NOBODY = 65534
-HIDDEN_FROM_SUBMISSIONS = ("solutions", "tests")  # and the installed FORBIDDEN_PACKAGES
+MAGIC = b"PCLW"
+PROTECTED = ("tests", "solutions", ".git")  # of the course copy: never readable by a submission
+
+# Paths inside the bubblewrap sandbox.
+SANDBOX_PYTHON_ROOT = "/python"
+SANDBOX_SITE = "/sandbox/site-packages"
+SANDBOX_WORKER = "/sandbox/worker.py"
+SANDBOX_SUBMISSION = "/submission"
+
+BUBBLEWRAP, UID, NONE = "bubblewrap", "uid", "none"
 
 
-class SandboxError(Exception):
-    """The worker failed: timeout, crash, or a result that is not plain data."""
+@dataclass(frozen=True)
+class Isolation:
+    """How a worker is isolated: ``level`` (bubblewrap, uid or none), the
+    uid that runs it (None: the grader's own) and, below bubblewrap, why."""
+
+    level: str
+    uid: int = None
+    reason: str = ""
+
+    @property
+    def isolated(self):
+        return self.level != NONE
+
+    def describe(self):
+        if self.level == BUBBLEWRAP:
+            who = f"uid {self.uid}" if self.uid is not None else "the grader's user"
+            return f"isolated: bubblewrap sandbox (no network, no files of the grader's), as {who}"
+        if self.level == UID:
+            return (f"isolated by file permissions only: dedicated uid {self.uid}, no namespaces "
+                    f"({self.reason}); the network was reachable")
+        return f"NOT ISOLATED ({self.reason}): this is a local check, not a mark"
 
 
-def _limits(unprivileged):
-    def apply():
-        os.setsid()  # its own process group: killed as a whole, forks included
-        resource.setrlimit(resource.RLIMIT_AS, (MEMORY_LIMIT, MEMORY_LIMIT))
-        resource.setrlimit(resource.RLIMIT_CPU, (CPU_LIMIT, CPU_LIMIT))
-        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-        if unprivileged:
-            resource.setrlimit(resource.RLIMIT_NPROC, (PROCESS_LIMIT, PROCESS_LIMIT))
-    return apply
+def _site_packages():
+    import sysconfig
+
+    return Path(sysconfig.get_paths()["purelib"]).resolve()
+
+
+def _python():
+    """The interpreter's real path and its path relative to ``sys.base_prefix``."""
+    executable = Path(sys.executable).resolve()
+    base = Path(sys.base_prefix).resolve()
+    try:
+        return executable, executable.relative_to(base)
+    except ValueError:
+        return executable, None
 
 
 def _make_reachable(path):
-    """Let the unprivileged worker reach ``path``: search permission (o+x) on its ancestors.
+    """Let the sandbox user reach ``path``: search permission (o+x) on its ancestors.
 
-    A clone in a private directory (``mktemp -d`` is mode 0700) would hide
-    the virtual environment's packages from ``nobody``. Search permission
-    alone lets it pass through a directory without listing it.
+    Search permission alone lets it pass through a directory without listing
+    it: a virtual environment under a private directory (``mktemp -d`` is
+    mode 0700, ``/root`` too) would otherwise be out of the sandbox user's
+    reach, and bubblewrap, which runs as that user, could not bind it.
     """
-    for parent in Path(path).resolve().parents:
+    for parent in [*Path(path).resolve().parents]:
         mode = parent.stat().st_mode
         if not mode & stat.S_IXOTH:
             os.chmod(parent, stat.S_IMODE(mode) | stat.S_IXOTH)
+
+
+def _site_dirs(root):
+    """Folders under ``root`` that Python may import packages from."""
+    patterns = ("lib/python3*/site-packages", "lib/python3*/dist-packages", "lib/python3/dist-packages",
+                "local/lib/python3*/site-packages", "local/lib/python3*/dist-packages",
+                "python3*/site-packages", "python3*/dist-packages", "python3/dist-packages")
+    found = {root} if root.name in ("site-packages", "dist-packages") else set()
+    for pattern in patterns:
+        found.update(p for p in root.glob(pattern) if p.is_dir())
+    return sorted(found)
+
+
+def _masked_entries(site):
+    """Entries of a site folder the submission must not see: the forbidden
+    packages (their modules, compiled libraries, bundled ``.libs`` and
+    metadata) and the editable install's files, which point back into the
+    course repository."""
+    import importlib.metadata
+
+    forbidden = set(config.FORBIDDEN_PACKAGES)
+    masked = set()
+    for entry in site.iterdir():
+        stem = entry.name.split(".")[0].split("-")[0]
+        if stem in forbidden or entry.name.startswith(("__editable__", "pcl_course", "pcl-course")) \
+                or entry.name.endswith(".egg-link"):
+            masked.add(entry)
+    for dist in importlib.metadata.distributions(path=[str(site)]):
+        tops = {Path(str(f)).parts[0] for f in (dist.files or []) if not str(f).startswith("..")}
+        modules = {t.split(".")[0] for t in tops}
+        if modules & forbidden or (dist.metadata["Name"] or "").lower().replace("_", "-") == "pcl-course":
+            masked.update(site / t for t in tops if (site / t).exists() or (site / t).is_symlink())
+    return sorted(masked)
+
+
+def _bubblewrap_command(staged_root, python_argv_tail):
+    """The ``bwrap`` command line that runs the worker on a staged submission."""
+    executable, relative = _python()
+    base = Path(sys.base_prefix).resolve()
+    site = _site_packages()
+    command = ["bwrap", "--unshare-all", "--unshare-user", "--disable-userns", "--die-with-parent",
+               "--new-session", "--clearenv", "--hostname", "sandbox", "--cap-drop", "ALL"]
+    system = [("/usr/lib", "/usr/lib"), ("/usr/lib64", "/usr/lib64"), ("/usr/lib32", "/usr/lib32")]
+    for source, target in system:
+        if Path(source).is_dir():
+            command += ["--ro-bind", source, target]
+            command += ["--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
+    command += ["--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache"]
+    mounts = [(base, SANDBOX_PYTHON_ROOT), (site, SANDBOX_SITE)]
+    for source, target in mounts:
+        command += ["--ro-bind", str(source), target]
+    # Mask the forbidden packages wherever the sandbox could import them from.
+    roots = [(Path(s), t) for s, t in system if Path(s).is_dir()] + mounts
+    for source_root, target_root in roots:
+        for site_dir in _site_dirs(Path(source_root)):
+            for entry in _masked_entries(site_dir):
+                target = f"{target_root}/{entry.relative_to(source_root)}"
+                if entry.is_dir() and not entry.is_symlink():
+                    command += ["--tmpfs", target]
+                else:
+                    command += ["--ro-bind", "/dev/null", target]
+    command += ["--ro-bind", str(staged_root / "pcl_course"), f"{SANDBOX_SUBMISSION}/pcl_course",
+                "--ro-bind", str(staged_root / WORKER.name), SANDBOX_WORKER,
+                "--proc", "/proc", "--dev", "/dev",
+                "--size", str(config.TMP_SIZE), "--tmpfs", "/tmp", "--chdir", "/tmp"]
+    for key, value in _environment("/tmp").items():
+        command += ["--setenv", key, value]
+    python = f"{SANDBOX_PYTHON_ROOT}/{relative}" if relative is not None else str(executable)
+    return [*command, python, "-I", "-S", SANDBOX_WORKER, SANDBOX_SITE, SANDBOX_SUBMISSION, *python_argv_tail]
+
+
+def _environment(home):
+    return {"PATH": "/usr/bin:/bin", "HOME": home, "TMPDIR": home, "LANG": "C.UTF-8",
+            "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+            "NUMBA_NUM_THREADS": "1", "NUMBA_CACHE_DIR": f"{home}/numba",
+            "OPEN3D_DISABLE_WEB_VISUALIZER": "true", "MPLBACKEND": "Agg"}
+
+
+def _preexec(uid):
+    """Run in the worker's process before exec: its own session, limits, the sandbox uid."""
+    def apply():
+        os.setsid()  # its own process group: killed as a whole, forks included
+        for limit, value in ((resource.RLIMIT_AS, config.MEMORY_LIMIT), (resource.RLIMIT_CPU, config.CPU_LIMIT),
+                             (resource.RLIMIT_FSIZE, config.FILE_SIZE_LIMIT), (resource.RLIMIT_CORE, 0)):
+            resource.setrlimit(limit, (value, value))
+        if uid is not None:
+            os.setgroups([])
+            os.setgid(uid)
+            os.setuid(uid)
+        if uid is not None or os.geteuid() != 0:
+            resource.setrlimit(resource.RLIMIT_NPROC, (config.PROCESS_LIMIT, config.PROCESS_LIMIT))
+    return apply
 
 
 def _become_subreaper():
@@ -88,103 +233,226 @@ def _become_subreaper():
         pass
 
 
-def _group_members(pgid):
-    members = 0
-    for stat in Path("/proc").glob("[0-9]*/stat"):
+def _processes():
+    """(pid, parent pid, process group, real uid) of every process."""
+    found = []
+    for entry in Path("/proc").glob("[0-9]*"):
         try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
+            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            uid = entry.stat().st_uid
         except (OSError, IndexError):
             continue
-        if int(fields[2]) == pgid:  # the process group: field 5 of /proc/PID/stat
-            members += 1
-    return members
-
-
-def _installed_packages(names):
-    """Directories of the installed packages ``names`` (without importing them)."""
-    import importlib.util
-
-    found = []
-    for name in names:
-        spec = importlib.util.find_spec(name)
-        if spec is not None and spec.submodule_search_locations:
-            found.extend(Path(p) for p in spec.submodule_search_locations)
+        found.append((int(entry.name), int(fields[1]), int(fields[2]), uid))
     return found
 
 
-def namespace_available():
-    return os.geteuid() == 0 and bool(shutil.which("unshare")) and bool(shutil.which("setpriv"))
+def _reap():
+    try:
+        while os.waitpid(-1, os.WNOHANG)[0] > 0:
+            pass
+    except ChildProcessError:
+        pass
+
+
+def kill_uid(uid):
+    """Kill every process of ``uid``: a child that takes that uid and calls ``kill(-1, SIGKILL)``."""
+    for _ in range(50):
+        if not any(p[3] == uid for p in _processes()):
+            return
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child
+            try:
+                os.setgroups([])
+                os.setgid(uid)
+                os.setuid(uid)
+                os.kill(-1, signal.SIGKILL)
+            finally:
+                os._exit(0)
+        os.waitpid(pid, 0)
+        time.sleep(0.02)
+        _reap()
+
+
+def _probe_script(paths):
+    return ("import os, sys\n"
+            f"sys.path.append({str(_site_packages())!r})\n"
+            "import numpy\n"
+            "readable = []\n"
+            f"for path in {[str(p) for p in paths]!r}:\n"
+            "    try:\n"
+            "        os.listdir(path) if os.path.isdir(path) else open(path).close()\n"
+            "        readable.append(path)\n"
+            "    except OSError:\n"
+            "        pass\n"
+            "import json\n"
+            "print(json.dumps(readable))\n")
+
+
+@lru_cache(maxsize=None)
+def isolation(uid=None):
+    """The strongest isolation available here for the sandbox ``uid``.
+
+    Parameters
+    ----------
+    uid : int, optional
+        The dedicated uid when the grader is root (default
+        :data:`grading.config.SANDBOX_UID_BASE`); ignored otherwise.
+
+    Returns
+    -------
+    Isolation
+    """
+    root = os.geteuid() == 0
+    uid = (uid if uid is not None else config.SANDBOX_UID_BASE) if root else None
+    if root:
+        _make_reachable(Path(sys.base_prefix) / "lib")
+        _make_reachable(_site_packages())
+    reasons = []
+    if shutil.which("bwrap"):
+        staged = Path(tempfile.mkdtemp(prefix="grading-probe-"))
+        try:
+            os.chmod(staged, 0o711)
+            (staged / "pcl_course").mkdir(mode=0o755)
+            (staged / WORKER.name).write_text("import sys\nsys.path.append(sys.argv[1])\nimport numpy\n")
+            (staged / WORKER.name).chmod(0o644)
+            command = _bubblewrap_command(staged, [])
+            completed = subprocess.run(command, capture_output=True, text=True, timeout=60,
+                                       preexec_fn=_preexec(uid), env={})
+            if completed.returncode == 0:
+                return Isolation(BUBBLEWRAP, uid)
+            reasons.append("bubblewrap cannot run here: " + (completed.stderr.strip().splitlines() or ["?"])[-1])
+        except (OSError, subprocess.SubprocessError) as exc:
+            reasons.append(f"bubblewrap cannot run here: {exc}")
+        finally:
+            shutil.rmtree(staged, ignore_errors=True)
+            if uid is not None:
+                kill_uid(uid)
+    else:
+        reasons.append("bubblewrap (bwrap) is not installed")
+    if not root:
+        return Isolation(NONE, None, "; ".join(reasons + ["the grader is not root, so no dedicated uid"]))
+    # The second wall: a dedicated uid that cannot read the grader's files.
+    protected = [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()]
+    try:
+        completed = subprocess.run([str(_python()[0]), "-I", "-S", "-c", _probe_script(protected)],
+                                   capture_output=True, text=True, timeout=60, preexec_fn=_preexec(uid), env={},
+                                   cwd="/")
+    except (OSError, subprocess.SubprocessError) as exc:
+        return Isolation(NONE, None, "; ".join(reasons + [f"uid {uid} cannot run Python: {exc}"]))
+    finally:
+        kill_uid(uid)
+    if completed.returncode != 0:
+        return Isolation(NONE, None, "; ".join(reasons + [
+            f"uid {uid} cannot use the Python environment at {sys.prefix}"]))
+    lines = [line for line in completed.stdout.splitlines() if line.startswith("[")]
+    readable = json.loads(lines[-1]) if lines else ["?"]
+    if readable:
+        return Isolation(NONE, None, "; ".join(reasons + [
+            f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
+            f"(chmod 700) and keep the Python environment outside it"]))
+    return Isolation(UID, uid, "; ".join(reasons))
+
+
+def require_isolation(level):
+    """Raise :class:`SandboxError` unless ``level`` isolates."""
+    if not level.isolated:
+        raise SandboxError(f"refusing to grade: the submission could not be isolated ({level.reason})")
 
 
 class Worker:
-    """One worker process for one submission; restarted after any failure."""
+    """One worker process for one staged submission; restarted after any failure.
 
-    def __init__(self, clone_dir, timeout=60.0):
-        self.clone_dir = str(Path(clone_dir).resolve())
+    Parameters
+    ----------
+    staged_root : path
+        The staging folder (:class:`grading.staging.StagedSubmission` root):
+        its ``pcl_course/`` is the submission.
+    timeout : float
+        Wall-clock seconds of one call, its module's import included.
+    uid : int, optional
+        The dedicated sandbox uid (when the grader is root).
+    """
+
+    def __init__(self, staged_root, timeout=config.CALL_TIMEOUT, uid=None):
+        self.staged_root = Path(staged_root).resolve()
         self.timeout = timeout
         self.process = None
-        self.isolated = namespace_available()
+        self.work = None
+        self.isolation = isolation(uid)
+        self.uid = self.isolation.uid
+        self.broken = {}  # module -> why it cannot be imported
 
     # -- process management ---------------------------------------------------
 
-    def _command(self, nonce, work, clone):
-        python = [sys.executable, "-I", str(Path(work) / WORKER.name), clone, nonce, work,
-                  ",".join(FORBIDDEN_PACKAGES)]
-        if not self.isolated:
-            return python
-        hidden = [REPO_ROOT / d for d in HIDDEN_FROM_SUBMISSIONS if (REPO_ROOT / d).is_dir()]
-        hidden += [p for p in _installed_packages(FORBIDDEN_PACKAGES)]
-        mounts = " && ".join(f"mount -t tmpfs -o size=64k,mode=0755 none '{path}'" for path in hidden)
-        drop = ["setpriv", f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups", "--"]
-        script = f"{mounts} && exec \"$@\"" if mounts else "exec \"$@\""
-        return ["unshare", "--mount", "--propagation", "private", "--fork", "--",
-                "sh", "-c", script, "sh", *drop, *python]
+    def _command(self):
+        tail = [",".join(config.FORBIDDEN_PACKAGES)]
+        if self.isolation.level == BUBBLEWRAP:
+            return _bubblewrap_command(self.staged_root, tail), {}
+        python = [str(_python()[0]), "-I", "-S", str(self.staged_root / WORKER.name), str(_site_packages()),
+                  str(self.staged_root), *tail]
+        return python, _environment(self.work)
 
     def start(self):
         _become_subreaper()
-        self.nonce = secrets.token_hex(8)
-        self.work = tempfile.mkdtemp(prefix="grading-worker-")
-        # The worker runs a snapshot of the package in its own directory: it
-        # needs no access to wherever the clone lives, and only pcl_course/
-        # comes along (no conftest.py, sitecustomize.py or .pth next to it).
-        clone = Path(self.work) / "submission"
-        shutil.copytree(Path(self.clone_dir) / "pcl_course", clone / "pcl_course",
-                        ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-        shutil.copy(WORKER, Path(self.work) / WORKER.name)  # readable wherever the grader lives
-        if self.isolated:
-            _make_reachable(Path(sys.prefix) / "lib")  # the environment's packages
-            for path in [Path(self.work), *Path(self.work).rglob("*")]:
-                os.chown(path, NOBODY, NOBODY)
+        shutil.copy(WORKER, self.staged_root / WORKER.name)
+        (self.staged_root / WORKER.name).chmod(0o644)
+        self.work = tempfile.mkdtemp(prefix="grading-home-")  # HOME of the uid and none levels
+        if self.uid is not None:
+            os.chown(self.work, self.uid, self.uid)
+        command, env = self._command()
         self.stderr = tempfile.TemporaryFile()
-        env = {"PATH": "/usr/bin:/bin", "HOME": self.work, "LANG": "C.UTF-8", "TMPDIR": self.work,
-               "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
-               "OPEN3D_DISABLE_WEB_VISUALIZER": "true", "MPLBACKEND": "Agg"}
-        self.process = subprocess.Popen(
-            self._command(self.nonce, self.work, str(clone)), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=self.stderr, env=env, cwd=self.work, preexec_fn=_limits(self.isolated),
-        )
+        self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                        stderr=self.stderr, env=env, cwd=self.work,
+                                        preexec_fn=_preexec(self.uid))
         self.buffer = b""
+        try:
+            header = self._read_frame(time.monotonic() + max(self.timeout, 60.0))
+            if not header.get("ready"):
+                raise SandboxError("the worker did not start")
+        except SandboxError as exc:
+            self.stop()
+            raise SandboxError(f"the sandbox could not start: {exc}") from None
+        self.baseline = self._members()
 
     def stop(self):
         if self.process is not None:
-            pgid = self.process.pid
             try:
-                os.killpg(pgid, signal.SIGKILL)
+                os.killpg(self.process.pid, signal.SIGKILL)
             except (ProcessLookupError, PermissionError):
                 pass
             self.process.wait()
             self.process = None
+            if self.uid is not None:
+                kill_uid(self.uid)
             deadline = time.monotonic() + 5.0
-            while _group_members(pgid) and time.monotonic() < deadline:
-                try:
-                    while os.waitpid(-1, os.WNOHANG)[0] > 0:
-                        pass
-                except ChildProcessError:
-                    pass
+            while time.monotonic() < deadline:
+                _reap()
+                if not self._leftovers():
+                    break
                 time.sleep(0.01)
-        if getattr(self, "work", None):
+        if self.work:
             shutil.rmtree(self.work, ignore_errors=True)
             self.work = None
+
+    def _leftovers(self):
+        if self.uid is not None:
+            return any(p[3] == self.uid for p in _processes())
+        return False
+
+    def _members(self):
+        """How many processes the worker runs: by its uid, else its descendants."""
+        processes = _processes()
+        if self.uid is not None:
+            return sum(1 for p in processes if p[3] == self.uid)
+        children = {}
+        for pid, parent, _, _ in processes:
+            children.setdefault(parent, []).append(pid)
+        count, stack = 0, [self.process.pid]
+        while stack:
+            pid = stack.pop()
+            count += 1
+            stack.extend(children.get(pid, ()))
+        return count
 
     def _stderr_tail(self):
         self.stderr.seek(0)
@@ -194,6 +462,13 @@ class Worker:
     # -- calls ------------------------------------------------------------------
 
     def call(self, module, function, args, kwargs):
+        """Call ``pcl_course.<module>.<function>(*args, **kwargs)`` in the worker.
+
+        Arrays and random generators among the arguments that the call
+        modified in place are modified the same way here.
+        """
+        if module in self.broken:
+            raise SandboxError(self.broken[module])
         if self.process is None or self.process.poll() is not None:
             self.stop()
             self.start()
@@ -211,88 +486,159 @@ class Worker:
         return result
 
     def _stray_processes(self):
-        """Whether the worker's process group holds more than the worker itself."""
-        expected = 2 if self.isolated else 1  # unshare and the worker, or the worker alone
-        return self.process is not None and _group_members(self.process.pid) > expected
+        return self.process is not None and self._members() > self.baseline
 
     def _call(self, module, function, args, kwargs):
-        request = pickle.dumps({"module": module, "function": function, "args": args, "kwargs": kwargs})
+        arguments = {"args": list(args), "kwargs": dict(kwargs)}
+        read_only = [path for path, value in _arrays(arguments, []) if not value.flags.writeable]
+        request = pickle.dumps({"module": module, "function": function, "args": args, "kwargs": kwargs,
+                                "read_only": read_only})
+        deadline = time.monotonic() + self.timeout
         try:
             self.process.stdin.write(struct.pack("<Q", len(request)) + request)
             self.process.stdin.flush()
         except BrokenPipeError:
             raise SandboxError(self._death_message()) from None
-        line = self._read_line()
-        answer = json.loads(line)
-        if not answer["ok"]:
+        try:
+            header = self._read_frame(deadline)
+        except SandboxError as exc:
+            self.broken[module] = (f"{module}.py cannot be imported: {exc}; every test of {module}.py "
+                                   "fails until its import is fixed")
+            raise SandboxError(self.broken[module]) from None
+        if not header.get("imported"):
+            failure = _exception(header) if header.get("phase") == "import" and "type" in header else None
+            what = f"raised {header.get('type')}: {header.get('message')}" if failure is not None else \
+                "the worker's answer was garbled"
+            where = f" (at {header['where']})" if isinstance(header.get("where"), str) and header["where"] else ""
+            self.broken[module] = (f"{module}.py cannot be imported: it {what}{where}; every test of "
+                                   f"{module}.py fails until its import is fixed")
+            raise SandboxError(self.broken[module])
+        answer = self._read_frame(deadline)
+        arrays = {}
+        if "npz" in answer:
+            data = self._read_frame(deadline, raw=True, expected=answer["npz"])
+            try:
+                with np.load(io.BytesIO(data), allow_pickle=False) as npz:
+                    arrays = {key: npz[key] for key in npz.files}
+            except Exception:
+                raise SandboxError("the worker's answer was garbled (unreadable arrays)") from None
+        _write_back(arguments, answer.get("modified", []), arrays)
+        if not answer.get("ok"):
             exc = _exception(answer)
             exc.from_submission = True  # the function raised: the worker itself is fine
             raise exc
-        arrays = {}
-        if "npz" in answer:
-            with np.load(answer["npz"], allow_pickle=False) as npz:
-                arrays = {key: npz[key] for key in npz.files}
-            os.unlink(answer["npz"])
         return _decode(answer["value"], arrays)
 
-    def _read_line(self):
-        deadline = time.monotonic() + self.timeout
+    def _read_exactly(self, size, deadline):
         stream = self.process.stdout.fileno()
-        marker = self.nonce.encode()
-        while True:
-            newline = self.buffer.find(b"\n")
-            if newline >= 0:
-                line, self.buffer = self.buffer[:newline], self.buffer[newline + 1:]
-                if line.startswith(marker):
-                    return line[len(marker):].decode("utf-8")
-                continue  # not an answer of the worker's: ignore it
+        while len(self.buffer) < size:
             remaining = deadline - time.monotonic()
             if remaining <= 0:
                 raise SandboxError(f"timed out: the call ran for more than {self.timeout:g} s")
             ready, _, _ = select.select([stream], [], [], remaining)
             if ready:
-                chunk = os.read(stream, 1 << 16)
+                chunk = os.read(stream, 1 << 20)
                 if not chunk:
                     raise SandboxError(self._death_message())
                 self.buffer += chunk
+        data, self.buffer = self.buffer[:size], self.buffer[size:]
+        return data
+
+    def _read_frame(self, deadline, raw=False, expected=None):
+        head = self._read_exactly(12, deadline)
+        size = struct.unpack("<Q", head[4:])[0]
+        if head[:4] != MAGIC or size > config.ANSWER_LIMIT or (expected is not None and size != expected):
+            raise SandboxError("the worker's answer was garbled")
+        payload = self._read_exactly(size, deadline)
+        if raw:
+            return payload
+        try:
+            header = json.loads(payload.decode("utf-8"))
+        except ValueError:
+            raise SandboxError("the worker's answer was garbled") from None
+        if not isinstance(header, dict):
+            raise SandboxError("the worker's answer was garbled")
+        return header
 
     def _death_message(self):
         code = self.process.wait()
         how = f"killed by signal {-code}" if code < 0 else f"exit status {code}"
         hint = ""
-        if code in (-signal.SIGKILL, -signal.SIGXCPU):
-            hint = " (a resource limit: memory, CPU time or processes)"
+        if code in (-signal.SIGKILL, -signal.SIGXCPU, -signal.SIGXFSZ):
+            hint = " (a resource limit: memory, CPU time, file size or processes)"
         tail = self._stderr_tail()
         return f"the submission's process died ({how}){hint}" + (f"; its last output:\n{tail}" if tail else "")
 
 
+def _arrays(value, path):
+    """(path, array) of every ndarray inside nested tuples, lists and dicts."""
+    if type(value) is np.ndarray:
+        yield path, value
+    elif type(value) in (tuple, list):
+        for i, item in enumerate(value):
+            yield from _arrays(item, [*path, i])
+    elif type(value) is dict:
+        for key, item in value.items():
+            yield from _arrays(item, [*path, key])
+
+
+def _write_back(arguments, modified, arrays):
+    """Apply to the grader's arguments what the call did to the worker's copies."""
+    if not isinstance(modified, list):
+        raise SandboxError("the worker's answer was garbled")
+    for change in modified:
+        try:
+            target = arguments
+            for step in change["path"]:
+                target = target[step]
+            if isinstance(target, np.random.Generator):
+                target.bit_generator.state = change["state"]
+            elif type(target) is np.ndarray:
+                value = _decode(change["value"], arrays)
+                if type(value) is np.ndarray and value.shape == target.shape and value.dtype == target.dtype \
+                        and target.flags.writeable:
+                    target[...] = value
+        except (KeyError, IndexError, TypeError, ValueError):
+            raise SandboxError("the worker's answer was garbled") from None
+
+
 def _exception(answer):
-    kind = answer["type"]
-    message = answer["message"]
-    where = f" (at {answer['where']})" if answer.get("where") else ""
-    cls = getattr(builtins, kind, None) if answer.get("builtin") else None
+    kind = str(answer.get("type"))
+    message = str(answer.get("message"))
+    where = answer.get("where") if isinstance(answer.get("where"), str) else ""
+    shown = f" (at {where})" if where else ""
+    cls = getattr(builtins, kind, None) if answer.get("builtin") is True else None
     if isinstance(cls, type) and issubclass(cls, Exception):
         try:
             exc = cls(message)
         except TypeError:  # a builtin whose constructor wants more (UnicodeDecodeError, ...)
-            return SandboxError(f"raised {kind}: {message}{where}")
-        exc.where = answer.get("where", "")
+            return SandboxError(f"raised {kind}: {message}{shown}")
+        exc.where = where
         return exc
-    return SandboxError(f"raised {kind}: {message}{where}")
+    return SandboxError(f"raised {kind}: {message}{shown}")
 
 
 def _decode(node, arrays):
-    kind = node["t"]
-    if kind == "ndarray":
-        return arrays[node["k"]]
-    if kind == "json":
-        return node["v"]
-    if kind == "npscalar":
-        return np.dtype(node["dtype"]).type(node["v"])
-    if kind in ("tuple", "list"):
-        items = [_decode(item, arrays) for item in node["items"]]
-        return tuple(items) if kind == "tuple" else items
-    if kind == "dict":
-        return {key: _decode(value, arrays) for key, value in node["items"].items()}
-    raise SandboxError(f"returned {node['what']}: return plain numpy arrays, numbers, strings, "
-                       "tuples, lists or dicts")
+    if not isinstance(node, dict):
+        raise SandboxError("the worker's answer was garbled")
+    kind = node.get("t")
+    try:
+        if kind == "ndarray":
+            return arrays[node["k"]]
+        if kind == "json":
+            value = node["v"]
+            if value is None or type(value) in (bool, int, float, str):
+                return value
+        elif kind == "npscalar":
+            return np.dtype(node["dtype"]).type(node["v"])
+        elif kind in ("tuple", "list"):
+            items = [_decode(item, arrays) for item in node["items"]]
+            return tuple(items) if kind == "tuple" else items
+        elif kind == "dict":
+            return {str(key): _decode(value, arrays) for key, value in node["items"].items()}
+        elif kind == "unsupported":
+            raise SandboxError(f"returned {node.get('what')}: return plain numpy arrays, numbers, strings, "
+                               "tuples, lists or dicts")
+    except (KeyError, TypeError, ValueError, AttributeError):
+        pass
+    raise SandboxError("the worker's answer was garbled")

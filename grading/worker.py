@@ -1,17 +1,27 @@
 """The worker process that runs a submission's code (started by grading/sandbox.py).
 
-It is a standalone script: it imports nothing from the grader. It reads call
-requests from the grader (length-prefixed pickles, written by the trusted
-grader only), runs the submission's function, and answers with one JSON line
-whose arrays sit in an ``.npz`` file: plain data that the grader loads with
-``allow_pickle=False``. The answer goes to a private copy of the original
-stdout, so that anything the submission prints goes to stderr instead.
+It is a standalone script: it imports nothing from the grader, and in the
+bubblewrap sandbox it is the only file of the grader's that exists. It reads
+call requests from the grader (length-prefixed pickles written by the trusted
+grader only), imports the submission's module, runs the function and answers
+with frames of plain data on a private copy of the original stdout: a JSON
+header, then the result's arrays as ``.npz`` bytes that the grader loads
+with ``allow_pickle=False``. Nothing goes through a file, so the grader never
+opens a path the worker names. Whatever the submission prints goes to stderr.
 
-Usage: python -I worker.py CLONE_DIR NONCE WORK_DIR FORBIDDEN_PACKAGES
-(the last a comma-separated list, from grading.forbidden).
+Each call is answered in two steps, so that the grader can tell a module
+that cannot be imported from a function that fails: first
+``{"imported": true}`` (or the import's failure), then the call's answer.
+The answer also names every argument the call modified in place, with its
+new value, so that the grader can apply the same change to its own copy:
+a sandboxed call then behaves as an in-process one.
+
+Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES
+(the last a comma-separated list, from grading.config).
 """
 
 import importlib
+import io
 import json
 import os
 import pickle
@@ -19,13 +29,7 @@ import struct
 import sys
 import traceback
 
-
-def _hide_the_grader():
-    """No editable-install finder (it would map ``solutions`` and ``grading``), no grader dir on the path."""
-    here = os.path.dirname(os.path.abspath(__file__))
-    sys.path[:] = [p for p in sys.path if p and os.path.abspath(p) != here]
-    sys.meta_path[:] = [f for f in sys.meta_path if "editable" not in type(f).__module__.lower()
-                        and "editable" not in getattr(f, "__name__", "").lower()]
+MAGIC = b"PCLW"
 
 
 class _ForbiddenImports:
@@ -62,6 +66,33 @@ def _encode(value, arrays, np):
     return {"t": "unsupported", "what": f"an object of type {kind.__module__}.{kind.__qualname__}"}
 
 
+def _mutable_arguments(value, path, np):
+    """(path, object) of every array and random generator inside the arguments."""
+    if type(value) is np.ndarray:
+        yield path, value
+    elif isinstance(value, np.random.Generator):
+        yield path, value
+    elif type(value) in (tuple, list):
+        for i, item in enumerate(value):
+            yield from _mutable_arguments(item, [*path, i], np)
+    elif type(value) is dict:
+        for key, item in value.items():
+            yield from _mutable_arguments(item, [*path, key], np)
+
+
+def _snapshot(value, np):
+    if isinstance(value, np.random.Generator):
+        return value.bit_generator.state
+    return value.copy()
+
+
+def _changed(value, before, np):
+    if isinstance(value, np.random.Generator):
+        return value.bit_generator.state != before
+    return (value.shape != before.shape or value.dtype != before.dtype
+            or not np.array_equal(value, before, equal_nan=value.dtype.kind in "fc"))
+
+
 def _where(exc):
     frames = [f for f in traceback.extract_tb(exc.__traceback__) if "pcl_course" in f.filename]
     if not frames:
@@ -70,39 +101,79 @@ def _where(exc):
     return f"{os.path.basename(frame.filename)}:{frame.lineno} in {frame.name}"
 
 
+def _failure(exc):
+    return {"ok": False, "type": type(exc).__name__, "builtin": type(exc).__module__ == "builtins",
+            "message": str(exc)[:2000], "where": _where(exc)}
+
+
+class _Protocol:
+    def __init__(self, stream):
+        self.stream = stream
+
+    def send(self, header, arrays=None, np=None):
+        if arrays:
+            buffer = io.BytesIO()
+            np.savez(buffer, allow_pickle=False, **arrays)
+            header["npz"] = buffer.tell()
+        payload = json.dumps(header, allow_nan=True).encode("utf-8")
+        self.stream.write(MAGIC + struct.pack("<Q", len(payload)) + payload)
+        if arrays:
+            self.stream.write(MAGIC + struct.pack("<Q", header["npz"]) + buffer.getvalue())
+        self.stream.flush()
+
+
+def _call(request, protocol, np):
+    try:
+        module = importlib.import_module(f"pcl_course.{request['module']}")
+    except BaseException as exc:  # noqa: B902 -- SystemExit at import is an answer too
+        protocol.send({**_failure(exc), "phase": "import"})
+        return
+    protocol.send({"imported": True})
+    arguments = {"args": list(request["args"]), "kwargs": dict(request["kwargs"])}
+    for path in request.get("read_only", ()):
+        array = arguments
+        for step in path:
+            array = array[step]
+        array.flags.writeable = False
+    watched = [(path, value, _snapshot(value, np)) for path, value in _mutable_arguments(arguments, [], np)]
+    try:
+        function = getattr(module, request["function"], None)
+        if function is None:
+            raise AttributeError(f"{request['module']}.py defines no function {request['function']}")
+        result = function(*arguments["args"], **arguments["kwargs"])
+        arrays = {}
+        answer = {"ok": True, "value": _encode(result, arrays, np)}
+    except BaseException as exc:  # noqa: B902 -- KeyboardInterrupt and SystemExit are answers too
+        arrays, answer = {}, _failure(exc)
+    modified = []
+    for path, value, before in watched:
+        if _changed(value, before, np):
+            if isinstance(value, np.random.Generator):
+                modified.append({"path": path, "state": value.bit_generator.state})
+            else:
+                modified.append({"path": path, "value": _encode(value, arrays, np)})
+    answer["modified"] = modified
+    protocol.send(answer, arrays, np)
+
+
 def main():
-    clone, nonce, work, forbidden = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4].split(",")
-    protocol = os.fdopen(os.dup(1), "w", buffering=1)
+    site_packages, submission, forbidden = sys.argv[1], sys.argv[2], sys.argv[3].split(",")
+    protocol = _Protocol(os.fdopen(os.dup(1), "wb", buffering=0))
     os.dup2(2, 1)  # the submission's prints go to stderr, not into the protocol
+    sys.stdout = sys.stderr
     requests = sys.stdin.buffer
-    _hide_the_grader()
     sys.meta_path.insert(0, _ForbiddenImports(forbidden))
-    sys.path.insert(0, clone)
+    sys.path[:] = [p for p in sys.path if p and os.path.isdir(p)] + [site_packages]
+    sys.path.insert(0, submission)
     import numpy as np
 
-    count = 0
+    protocol.send({"ready": True})
     while True:
         header = requests.read(8)
         if len(header) < 8:
             return
         request = pickle.loads(requests.read(struct.unpack("<Q", header)[0]))  # written by the grader
-        count += 1
-        try:
-            module = importlib.import_module(f"pcl_course.{request['module']}")
-            function = getattr(module, request["function"], None)
-            if function is None:
-                raise AttributeError(f"{request['module']}.py defines no function {request['function']}")
-            result = function(*request["args"], **request["kwargs"])
-            arrays = {}
-            answer = {"ok": True, "value": _encode(result, arrays, np)}
-            if arrays:
-                path = os.path.join(work, f"result{count}.npz")
-                np.savez(path, allow_pickle=False, **arrays)
-                answer["npz"] = path
-        except BaseException as exc:  # noqa: B902 -- KeyboardInterrupt and SystemExit are answers too
-            answer = {"ok": False, "type": type(exc).__name__, "builtin": type(exc).__module__ == "builtins",
-                      "message": str(exc)[:2000], "where": _where(exc)}
-        protocol.write(nonce + json.dumps(answer, allow_nan=True) + "\n")
+        _call(request, protocol, np)
 
 
 if __name__ == "__main__":

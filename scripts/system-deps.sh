@@ -3,11 +3,13 @@
 #   libusb-1.0-0 : `import open3d` fails without libusb-1.0.so.0
 #   chromium     : the browser the book's page tests drive (Playwright cannot
 #                  download its own browser here)
+#   bubblewrap   : the grader's sandbox (bwrap) for students' code
 set -euo pipefail
 
 missing=()
 ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0' || missing+=(libusb-1.0-0)
 [ -x /usr/bin/chromium ] || missing+=(chromium)
+command -v bwrap >/dev/null 2>&1 || missing+=(bubblewrap)
 
 [ ${#missing[@]} -eq 0 ] && exit 0
 

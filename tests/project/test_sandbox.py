@@ -11,7 +11,13 @@ import pytest
 from conftest import run_grader
 
 from grading import REPO_ROOT
-from grading.sandbox import SandboxError, Worker, namespace_available
+from grading.errors import SandboxError
+from grading.sandbox import Worker, isolation
+from grading.staging import stage
+
+
+def namespace_available():
+    return isolation().level == "bubblewrap"
 
 EVIL = textwrap.dedent('''
     import os, sys, time
@@ -99,7 +105,7 @@ def worker(tmp_path):
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
     (package / "evil.py").write_text(EVIL)
-    w = Worker(package.parent, timeout=10)
+    w = Worker(stage(package).root, timeout=10)
     yield w
     w.stop()
 
@@ -138,7 +144,8 @@ def test_the_environment_is_stripped(worker, monkeypatch):
     environment = worker.call("evil", "environment", (), {})
     assert "GRADER_SECRET_TOKEN" not in environment and set(environment) <= {
         "PATH", "HOME", "LANG", "TMPDIR", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
-        "OPEN3D_DISABLE_WEB_VISUALIZER", "MPLBACKEND", "LC_CTYPE", "PWD", "SHLVL", "_"}
+        "OPEN3D_DISABLE_WEB_VISUALIZER", "MPLBACKEND", "NUMBA_NUM_THREADS", "NUMBA_CACHE_DIR", "LC_CTYPE",
+        "PWD", "SHLVL", "_"}
 
 
 def test_forbidden_packages_cannot_be_imported_at_run_time(worker):
@@ -146,7 +153,7 @@ def test_forbidden_packages_cannot_be_imported_at_run_time(worker):
         worker.call("evil", "import_open3d", (), {})
 
 
-@pytest.mark.skipif(not namespace_available(), reason="needs root with util-linux unshare and setpriv")
+@pytest.mark.skipif(not namespace_available(), reason="needs bubblewrap")
 def test_forbidden_packages_are_gone_even_without_the_import_blocker(worker):
     with pytest.raises(ImportError):
         worker.call("evil", "import_sklearn_around_the_blocker", (), {})
@@ -157,11 +164,12 @@ def test_the_reference_is_not_importable(worker):
         worker.call("evil", "import_reference", (), {})
 
 
-@pytest.mark.skipif(not namespace_available(), reason="needs root with util-linux unshare and setpriv")
+@pytest.mark.skipif(not namespace_available(), reason="needs bubblewrap")
 def test_the_reference_and_the_tests_are_not_readable(worker):
     with pytest.raises((FileNotFoundError, PermissionError)):
         worker.call("evil", "read_reference", (), {})
-    assert worker.call("evil", "list_tests", (), {}) == []
+    with pytest.raises((FileNotFoundError, PermissionError)):  # the course folder does not exist there
+        worker.call("evil", "list_tests", (), {})
 
 
 def reference_source(module):
@@ -215,11 +223,11 @@ def test_exit_at_import_and_tampering_files_change_nothing_else(tmp_path):
     assert not marker.exists()
 
 
-@pytest.mark.skipif(not namespace_available(), reason="needs root with util-linux unshare and setpriv")
+@pytest.mark.skipif(not namespace_available(), reason="needs bubblewrap")
 def test_the_results_file_cannot_be_overwritten(worker, tmp_path):
     # The grader writes its results in directories of its own (root, 0700).
     results = tmp_path / "results.json"
     results.write_text('{"score": 0}')
-    with pytest.raises(PermissionError):
+    with pytest.raises((PermissionError, FileNotFoundError)):
         worker.call("evil", "overwrite", (str(results),), {})
     assert results.read_text() == '{"score": 0}'
