@@ -195,7 +195,26 @@ def _bubblewrap_command(staged_root, python_argv_tail):
     for key, value in _environment("/tmp").items():
         command += ["--setenv", key, value]
     python = f"{SANDBOX_PYTHON_ROOT}/{relative}" if relative is not None else str(executable)
-    return [*command, python, "-I", "-S", SANDBOX_WORKER, SANDBOX_SITE, SANDBOX_SUBMISSION, *python_argv_tail]
+    return [*command, "--", python, "-I", "-S", SANDBOX_WORKER, SANDBOX_SITE, SANDBOX_SUBMISSION,
+            *python_argv_tail]
+
+
+def _spawn(command, **kwargs):
+    """Start ``command``; a ``bwrap`` command gets its arguments through a pipe
+    (``--args FD``), so that no path of the grader's shows in the sandbox's
+    ``/proc/1/cmdline``."""
+    if command[0] != "bwrap":
+        return subprocess.Popen(command, **kwargs)
+    end = command.index("--")  # the options go through the pipe, the sandbox's own command line stays
+    read, write = os.pipe()
+    try:
+        os.write(write, b"".join(arg.encode() + b"\0" for arg in command[1:end]))
+    finally:
+        os.close(write)
+    try:
+        return subprocess.Popen(["bwrap", "--args", str(read), *command[end:]], pass_fds=(read,), **kwargs)
+    finally:
+        os.close(read)
 
 
 def _environment(home):
@@ -316,11 +335,12 @@ def isolation(uid=None):
             (staged / WORKER.name).write_text("import sys\nsys.path.append(sys.argv[1])\nimport numpy\n")
             (staged / WORKER.name).chmod(0o644)
             command = _bubblewrap_command(staged, [])
-            completed = subprocess.run(command, capture_output=True, text=True, timeout=60,
-                                       preexec_fn=_preexec(uid), env={})
-            if completed.returncode == 0:
+            probe = _spawn(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           preexec_fn=_preexec(uid), env={})
+            _, stderr = probe.communicate(timeout=60)
+            if probe.returncode == 0:
                 return Isolation(BUBBLEWRAP, uid)
-            reasons.append("bubblewrap cannot run here: " + (completed.stderr.strip().splitlines() or ["?"])[-1])
+            reasons.append("bubblewrap cannot run here: " + (stderr.strip().splitlines() or ["?"])[-1])
         except (OSError, subprocess.SubprocessError) as exc:
             reasons.append(f"bubblewrap cannot run here: {exc}")
         finally:
@@ -401,7 +421,7 @@ class Worker:
             os.chown(self.work, self.uid, self.uid)
         command, env = self._command()
         self.stderr = tempfile.TemporaryFile()
-        self.process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+        self.process = _spawn(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                         stderr=self.stderr, env=env, cwd=self.work,
                                         preexec_fn=_preexec(self.uid))
         self.buffer = b""
