@@ -75,3 +75,31 @@ def check_unit_columns_match(actual, expected, name, atol=1e-6, hint=""):
         if hint:
             message += f"\n  hint: {hint}"
         raise AssertionError(message)
+
+
+def check_finite(value, name, hint=""):
+    """Every entry of ``value`` is finite (no NaN, no inf)."""
+    value = np.asarray(value, dtype=float)
+    bad = np.flatnonzero(~np.isfinite(value))
+    if bad.size:
+        index = tuple(int(i) for i in np.unravel_index(bad[0], value.shape))
+        message = f"{name} must be finite, but {bad.size} of {value.size} values are not (first at {index})"
+        if hint:
+            message += f"\n  hint: {hint}"
+        raise AssertionError(message)
+
+
+def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
+    """The columns of ``matrix`` are unit vectors, orthogonal to each other."""
+    matrix = np.asarray(matrix, dtype=float)
+    check_finite(matrix, name, hint=hint)
+    gram = matrix.T @ matrix
+    error = np.abs(gram - np.eye(gram.shape[0]))
+    if error.max() > atol:
+        i, j = (int(k) for k in np.unravel_index(np.argmax(error), error.shape))
+        what = f"column {i} has norm {np.sqrt(gram[i, i]):.6g}" if i == j else \
+            f"columns {i} and {j} have dot product {gram[i, j]:.6g}"
+        message = f"{name} must have orthonormal columns, but {what}"
+        if hint:
+            message += f"\n  hint: {hint}"
+        raise AssertionError(message)

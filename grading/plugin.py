@@ -57,6 +57,8 @@ def pytest_addoption(parser):
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "points(n): marks that a graded test is worth")
+    config.addinivalue_line("markers", "interface: a graded test of shapes, dtypes, errors or in-place "
+                                       "changes only (a degenerate answer may pass it)")
     config.stash[_RESULTS_KEY] = {}
 
 

@@ -307,6 +307,43 @@ def _probe_script(paths):
             "print(json.dumps(readable))\n")
 
 
+_HELD_UIDS = {}  # uid -> the open lock file that reserves it for this process
+
+
+def reserve_uid(preferred=None):
+    """A sandbox uid that no other grading process on this machine uses now.
+
+    The uids of :data:`grading.config.SANDBOX_UID_BASE` onwards are reserved
+    with an exclusive ``flock`` on a lock file in a root-only folder, held
+    until this process exits: two graders (two ``batch`` slots, two test
+    workers, two instructors) never share a uid, so that killing what one
+    left running never touches the other.
+    """
+    import fcntl
+
+    if _HELD_UIDS:
+        return next(iter(_HELD_UIDS))
+    folder = Path(tempfile.gettempdir()) / "pcl-grading-uids"
+    folder.mkdir(mode=0o700, exist_ok=True)
+    if folder.stat().st_uid != os.geteuid() or stat.S_IMODE(folder.stat().st_mode) & 0o077:
+        raise SandboxError(f"{folder} must belong to the grader's user with mode 0700")
+    base, slots = config.SANDBOX_UID_BASE, config.SANDBOX_UID_SLOTS
+    order = list(range(base, base + slots))
+    if preferred is not None and preferred in order:
+        order.remove(preferred)
+        order.insert(0, preferred)
+    for uid in order:
+        handle = open(folder / f"{uid}.lock", "w")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        _HELD_UIDS[uid] = handle
+        return uid
+    raise SandboxError(f"all {slots} sandbox uids from {base} are in use by other graders")
+
+
 @lru_cache(maxsize=None)
 def isolation(uid=None):
     """The strongest isolation available here for the sandbox ``uid``.
@@ -314,15 +351,15 @@ def isolation(uid=None):
     Parameters
     ----------
     uid : int, optional
-        The dedicated uid when the grader is root (default
-        :data:`grading.config.SANDBOX_UID_BASE`); ignored otherwise.
+        The preferred dedicated uid when the grader is root (the one
+        reserved is :func:`reserve_uid`'s); ignored otherwise.
 
     Returns
     -------
     Isolation
     """
     root = os.geteuid() == 0
-    uid = (uid if uid is not None else config.SANDBOX_UID_BASE) if root else None
+    uid = reserve_uid(uid) if root else None
     if root:
         _make_reachable(Path(sys.base_prefix) / "lib")
         _make_reachable(_site_packages())

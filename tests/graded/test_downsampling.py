@@ -9,7 +9,7 @@ statistically over fixed seeds.
 import numpy as np
 import pytest
 
-from grading.checks import check_array, check_close
+from grading.checks import check_array, check_close, check_finite, check_orthonormal_columns
 
 
 def voxel_keys(xyz, size):
@@ -39,6 +39,7 @@ def cloud():
 # --- voxel_grid_downsample ------------------------------------------------------
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_voxel_grid_downsample_returns_a_float64_array(impl, cloud):
     result = impl.voxel_grid_downsample(cloud, 0.25)
     check_array(result, "downsampled", shape=(None, 5))
@@ -92,7 +93,7 @@ def test_voxel_grid_downsample_on_a_grid_too_large_for_int64(impl):
     # D_x = D_y = 2^16 and h_z = 2^32: the linear index of the last point is
     # 2^64, which wraps to 0 in int64 and would merge it with the first.
     points = np.array([[0.0, 0.0, 0.0], [65535.0, 65535.0, 0.0], [0.0, 0.0, 2.0**32], [1.0, 0.0, 2.0**32]])
-    result = impl.voxel_grid_downsample(points, 1.0)
+    result = impl.voxel_grid_downsample(points[[2, 0, 3, 1]], 1.0)  # the output is in voxel order
     check_close(result, points, "downsampled",
                 hint="4 distinct voxels; the linear index overflows int64 here: sort by (h_z, h_y, h_x) instead")
 
@@ -138,6 +139,7 @@ def test_voxel_grid_downsample_random_is_reproducible(impl, cloud):
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_voxel_grid_downsample_empty_cloud(impl):
     result = impl.voxel_grid_downsample(np.empty((0, 4)), 0.5)
     check_array(result, "downsampled", shape=(0, 4))
@@ -148,6 +150,7 @@ def test_voxel_grid_downsample_empty_cloud(impl):
     ({"voxel_size": 0.0}, "voxel_size"), ({"voxel_size": -1.0}, "voxel_size"),
     ({"method": "median"}, "method"), ({"points": np.zeros((4, 2))}, "points"),
 ], ids=["size-zero", "size-negative", "method", "width"])
+@pytest.mark.interface
 def test_voxel_grid_downsample_rejects_bad_input(impl, kwargs, name):
     arguments = {"points": np.random.default_rng(33).uniform(size=(10, 3)), "voxel_size": 0.5, **kwargs}
     with pytest.raises(ValueError) as excinfo:
@@ -231,6 +234,7 @@ def test_approximate_voxel_downsample_random_returns_rows_of_the_container(impl)
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_approximate_voxel_downsample_rejects_bad_input(impl):
     points = np.random.default_rng(35).uniform(size=(10, 3))
     for kwargs, name in (({"n_containers": 0}, "n_containers"), ({"voxel_size": 0.0}, "voxel_size"),
@@ -244,6 +248,7 @@ def test_approximate_voxel_downsample_rejects_bad_input(impl):
 # --- farthest_point_sampling -------------------------------------------------------------
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_farthest_point_sampling_returns_int64_indices(impl, cloud):
     result = impl.farthest_point_sampling(cloud, 10)
     check_array(result, "indices", shape=(10,), dtype="int64")
@@ -327,6 +332,10 @@ def test_farthest_point_sampling_matches_open3d(impl):
 @pytest.mark.points(1)
 def test_farthest_point_sampling_extremes_and_errors(impl, cloud):
     check_array(impl.farthest_point_sampling(cloud, 0), "indices", shape=(0,), dtype="int64")
+    every = impl.farthest_point_sampling(cloud, len(cloud), start_index=7)
+    check_array(every, "indices", shape=(len(cloud),), dtype="int64")
+    assert every[0] == 7 and np.array_equal(np.sort(every), np.arange(len(cloud))), (
+        "n_samples = N selects every point once, starting at start_index")
     for kwargs, name in (({"n_samples": 3001}, "n_samples"), ({"n_samples": -1}, "n_samples"),
                          ({"start_index": 3000}, "start_index")):
         arguments = {"points": cloud, "n_samples": 5, **kwargs}
@@ -410,6 +419,7 @@ def test_normal_space_sampling_bucket_boundaries(impl):
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_normal_space_sampling_rejects_bad_input(impl, skewed_normals):
     for kwargs, name in (({"n_samples": 1001}, "n_samples"), ({"n_bins": 0}, "n_bins"),
                          ({"normals": np.zeros((5, 2))}, "normals")):

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy.spatial.distance import cdist
 
-from grading.checks import check_array, check_close
+from grading.checks import check_array, check_close, check_finite, check_orthonormal_columns
 
 
 # --- radius_outlier_removal ------------------------------------------------------
@@ -43,6 +43,7 @@ def test_radius_outlier_removal_matches_brute_force(impl):
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_radius_outlier_removal_empty_and_errors(impl):
     check_array(impl.radius_outlier_removal(np.empty((0, 3)), 1.0, 2), "keep", shape=(0,), dtype="bool")
     with pytest.raises(ValueError) as excinfo:
@@ -106,9 +107,12 @@ def test_statistical_outlier_removal_is_one_sided(impl):
     clump = rng.normal(scale=0.01, size=(10, 3))
     points = np.vstack([sparse, clump])
     keep = impl.statistical_outlier_removal(points, 4, 1.0)
+    check_array(keep, "keep", shape=(210,), dtype="bool")
     mean_d = mean_distances(points, 4)
     assert np.all(mean_d[-10:] < mean_d.mean() - 1.0 * mean_d.std(ddof=1)), "test set-up"
     assert keep[-10:].all(), "points with a small mean distance (a dense clump) must be kept: one-sided test"
+    far = mean_d > mean_d.mean() + 1.0 * mean_d.std(ddof=1)
+    assert far.any() and not keep[far].any(), "points with a mean distance above mu + std_ratio * sigma go"
 
 
 @pytest.mark.points(2)
@@ -127,6 +131,7 @@ def test_statistical_outlier_removal_uses_the_sample_standard_deviation(impl):
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_statistical_outlier_removal_rejects_bad_k(impl):
     points = np.random.default_rng(54).normal(size=(10, 3))
     for bad in (0, 10):
@@ -175,6 +180,10 @@ def test_bilateral_filter_image_leaves_a_constant_image_unchanged(impl):
     image = np.full((7, 9), 5.0)
     check_close(impl.bilateral_filter_image(image, 2.0, 10.0), image, "filtered constant image",
                 hint="pixels outside the image do not count (no zero padding)")
+    noisy = image + np.random.default_rng(60).normal(scale=0.1, size=image.shape)
+    smoothed = impl.bilateral_filter_image(noisy, 2.0, 10.0)
+    assert np.abs(smoothed - 5.0).max() < 0.5 * np.abs(noisy - 5.0).max(), (
+        "with sigma_r = 10 the filter is a Gaussian blur: noise on a constant image must shrink")
 
 
 @pytest.mark.points(2)
@@ -186,6 +195,10 @@ def test_bilateral_filter_image_keeps_a_step_edge(impl):
         f"a step of 1 with sigma_r = 0.1 must survive, but moved by up to {np.abs(result - image).max():.3f}; "
         "hint: the range weight exp(-(I_p - I_q)^2 / (2 sigma_r^2))"
     )
+    noisy = image + np.random.default_rng(61).normal(scale=0.01, size=image.shape)
+    result = impl.bilateral_filter_image(noisy, 2.0, 0.1)
+    assert np.abs(result - image).max() < 0.05 and (result - image).std() < 0.8 * (noisy - image).std(), (
+        "a noisy step with sigma_r = 0.1: the edge must survive and the noise on each side must shrink")
 
 
 # --- bilateral_filter_points ------------------------------------------------------------
@@ -199,6 +212,11 @@ def test_bilateral_filter_points_leaves_a_plane_on_its_plane(impl):
     check_array(result, "filtered", shape=(300, 3))
     check_close(result, points, "filtered plane", atol=1e-12,
                 hint="on a plane every h = n_p . (q - p) is 0: points must not move")
+    lifted = points.copy()
+    lifted[0, 2] += 0.05
+    result = impl.bilateral_filter_points(lifted, normals, 0.3, 0.2, 0.1)
+    assert abs(result[0, 2] - 2.0) < 0.04, (
+        f"a point 0.05 above the plane must be pulled towards it, got height {result[0, 2] - 2.0:.4f}")
 
 
 @pytest.mark.points(3)
@@ -226,6 +244,7 @@ def test_bilateral_filter_points_moves_only_along_the_normal(impl):
     normals = rng.normal(size=(150, 3))
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     moved = impl.bilateral_filter_points(points, normals, 0.8, 0.4, 0.2) - points
+    assert np.abs(moved).max() > 1e-3, "points of a noisy, curved cloud must move"
     sideways = np.linalg.norm(np.cross(moved, normals), axis=1)
     assert sideways.max() < 1e-9, (
         f"points moved {sideways.max():.3g} across their normal: p' = p + n_p * (a scalar), "

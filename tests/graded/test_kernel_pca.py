@@ -12,7 +12,7 @@ import pytest
 from sklearn.decomposition import KernelPCA
 from sklearn.metrics import pairwise
 
-from grading.checks import check_array, check_close
+from grading.checks import check_array, check_close, check_finite, check_orthonormal_columns
 
 
 def sklearn_kernel(x, y, kernel, beta=1.0, degree=2):
@@ -79,6 +79,7 @@ def test_kernel_matrix_closed_forms(impl, kernel):
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_kernel_matrix_rejects_unknown_kernel_and_bad_beta(impl):
     x = np.zeros((2, 2))
     with pytest.raises(ValueError) as excinfo:
@@ -92,6 +93,7 @@ def test_kernel_matrix_rejects_unknown_kernel_and_bad_beta(impl):
 # --- kernel_pca -------------------------------------------------------------
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_kernel_pca_returns_arrays_of_the_right_shapes(impl, blob):
     result = impl.kernel_pca(blob, 3)
     assert isinstance(result, tuple) and len(result) == 3, "kernel_pca returns (projections, eigenvalues, alphas)"
@@ -122,6 +124,8 @@ def test_kernel_pca_projections_match_sklearn(impl, blob, kernel):
 @pytest.mark.points(2)
 def test_kernel_pca_alphas_are_scaled_eigenvectors(impl, blob):
     projections, eigenvalues, alphas = impl.kernel_pca(blob, 3, kernel="gaussian", beta=0.5)
+    check_finite(eigenvalues, "eigenvalues")
+    check_finite(alphas, "alphas")
     check_close(np.sum(alphas**2, axis=0), 1.0 / eigenvalues, "||alphas[:, r]||^2",
                 rtol=1e-6, hint="scale each unit eigenvector by 1 / sqrt(eigenvalue)")
     k = np.exp(-0.5 * np.sum((blob[:, None] - blob[None]) ** 2, axis=2))
@@ -149,6 +153,7 @@ def test_kernel_pca_with_the_linear_kernel_is_linear_pca(impl):
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_kernel_pca_rejects_bad_n_components(impl, blob):
     for bad in (0, 61):
         with pytest.raises(ValueError) as excinfo:

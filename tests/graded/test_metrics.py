@@ -32,9 +32,14 @@ def test_chamfer_distance_matches_brute_force(impl):
 def test_chamfer_distance_of_identical_sets_is_zero(impl):
     a = np.random.default_rng(42).normal(size=(50, 3))
     assert impl.chamfer_distance(a, a[::-1]) == pytest.approx(0.0, abs=1e-12)
+    # ... and only those: a unit grid moved by 0.1 is 0.1^2 away in both directions.
+    grid = np.stack(np.meshgrid(*[np.arange(4.0)] * 3), axis=-1).reshape(-1, 3)
+    assert impl.chamfer_distance(grid, grid + [0.1, 0.0, 0.0]) == pytest.approx(0.02, rel=1e-9), (
+        "a unit grid and its copy moved by 0.1 along x: 0.01 + 0.01 = 0.02")
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_chamfer_distance_rejects_bad_input(impl):
     a = np.zeros((5, 3))
     with pytest.raises(ValueError) as excinfo:
@@ -68,3 +73,7 @@ def test_depth_metrics_of_a_perfect_prediction(impl):
     gt[::3] = 0.0
     result = impl.depth_metrics(np.where(gt > 0, gt, 7.0), gt)
     assert all(abs(result[k]) < 1e-9 for k in ("rmse", "mae", "irmse", "imae")), result
+    # ... and a prediction 1 m too far everywhere is 1000 mm off on every valid pixel.
+    off = impl.depth_metrics(np.where(gt > 0, gt + 1.0, 7.0), gt)
+    assert abs(off["rmse"] - 1000.0) < 1e-6 and abs(off["mae"] - 1000.0) < 1e-6, (
+        f"a prediction 1 m too far must give rmse = mae = 1000 mm, got {off}")

@@ -8,7 +8,7 @@ Eigenvectors are compared up to sign, as the contract allows.
 import numpy as np
 import pytest
 
-from grading.checks import check_array, check_close, check_unit_columns_match
+from grading.checks import check_array, check_close, check_finite, check_orthonormal_columns, check_unit_columns_match
 
 
 def random_rotation(rng, d):
@@ -43,6 +43,7 @@ def known():
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_pca_returns_plain_float64_arrays(impl, known):
     points, _, _ = known
     result = impl.pca(points)
@@ -75,6 +76,9 @@ def test_pca_columns_satisfy_the_eigen_equation(impl):
     points = rng.standard_normal((200, 4)) @ rng.standard_normal((4, 4)) + [5.0, -2.0, 0.5, 9.0]
     eigenvalues, eigenvectors = impl.pca(points)
     h = population_covariance(points)
+    # H @ 0 == 0 * lambda: the eigen-equation alone lets zero (or NaN) columns through.
+    check_orthonormal_columns(eigenvectors, "eigenvectors", atol=1e-8,
+                              hint="the contract: eigenvectors are orthonormal columns (np.linalg.eigh gives them)")
     check_close(h @ eigenvectors, eigenvectors * eigenvalues, "H @ eigenvectors", atol=1e-8,
                 hint="H @ eigenvectors[:, i] must equal eigenvalues[i] * eigenvectors[:, i]")
 
@@ -173,6 +177,7 @@ def test_pca_principal_axis_of_a_cylinder(impl):
     v = np.cross(axis, u)
     points = t[:, None] * axis + 0.3 * (np.cos(angle)[:, None] * u + np.sin(angle)[:, None] * v)
     _, eigenvectors = impl.pca(points + [10.0, 20.0, 30.0])
+    check_orthonormal_columns(eigenvectors, "eigenvectors", atol=1e-8)
     assert abs(eigenvectors[:, 0] @ axis) > 0.999, (
         f"the first principal axis of a long cylinder along {axis.round(3)} must be that axis, "
         f"got {eigenvectors[:, 0].round(3)}"
@@ -189,6 +194,7 @@ def test_pca_accepts_lists_and_other_dimensions(impl):
 
 
 @pytest.mark.points(1)
+@pytest.mark.interface
 def test_pca_does_not_modify_its_input(impl, known):
     points, _, _ = known
     original = points.copy()
@@ -203,6 +209,7 @@ def test_pca_does_not_modify_its_input(impl, known):
     (np.array([[0.0, 1.0, 2.0], [np.nan, 1.0, 0.0], [1.0, 1.0, 1.0]]), "NaN"),
     (np.array([[0.0, 1.0, 2.0], [np.inf, 1.0, 0.0], [1.0, 1.0, 1.0]]), "inf"),
 ], ids=["1d", "3d", "nan", "inf"])
+@pytest.mark.interface
 def test_pca_rejects_bad_points(impl, bad, why):
     with pytest.raises(ValueError) as excinfo:
         impl.pca(bad)

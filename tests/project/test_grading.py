@@ -108,3 +108,46 @@ def test_junit_xml_is_written(tmp_path):
          str(tmp_path / "results.xml")], cwd=REPO_ROOT, capture_output=True, text=True)
     assert completed.returncode == 0
     assert "<testsuite" in (tmp_path / "results.xml").read_text()
+
+
+# -- degenerate answers (tests/mutants/degenerate.py) ---------------------------------------------
+
+def _graded_test_functions():
+    """Test name -> test function, for every graded test module (public and hidden)."""
+    import importlib.util
+
+    functions = {}
+    for path in sorted((REPO_ROOT / "tests").glob("*/test_*.py")):
+        if path.parent.name not in ("graded", "hidden"):
+            continue
+        spec = importlib.util.spec_from_file_location(f"_graded_tests_{path.parent.name}_{path.stem}", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        functions.update({name: value for name, value in vars(module).items() if name.startswith("test_")})
+    return functions
+
+
+def _is_interface_test(function):
+    return any(mark.name == "interface" for mark in getattr(function, "pytestmark", []))
+
+
+DEGENERATE = [(f, k) for f in GRADED_FUNCTIONS for k in ("zeros", "nan", "echo", "random")]
+
+
+@pytest.mark.parametrize("function, kind", DEGENERATE, ids=[f"{f}-{k}" for f, k in DEGENERATE])
+def test_a_degenerate_answer_fails_every_test_of_values(function, kind, tmp_path):
+    sys.path.insert(0, str(REPO_ROOT / "tests" / "mutants"))
+    try:
+        from degenerate import source
+    finally:
+        sys.path.pop(0)
+    module_file = tmp_path / function / f"{kind}.py"
+    module_file.parent.mkdir()
+    module_file.write_text(source(function, GRADED_FUNCTIONS[function], kind))
+    summary = grade_one_function(module_file, tmp_path)
+    tests = _graded_test_functions()
+    longer = [g for g in GRADED_FUNCTIONS if g != function and g.startswith(function + "_")]
+    own = [t for t in summary["tests"] if not any(t["name"].startswith(f"test_{g}_") for g in longer)]
+    passed = [t["name"] for t in own if t["status"] == "passed"
+              and not _is_interface_test(tests[t["name"].split("[")[0]])]
+    assert not passed, f"a {kind} answer of {function} passes tests of values: {passed}"
