@@ -60,7 +60,7 @@ make book    # set up, then build the book (it runs YOUR code) into _build/html
 make test    # set up, then your marks on the public tests
 ```
 
-`make setup` (run by both) installs `libusb-1.0-0` and `chromium` with apt when
+`make setup` (run by both) installs `libusb-1.0-0`, `bubblewrap` and `chromium` with apt when
 it can, a `.venv` with the pinned requirements, and this package.
 
 ## Workflow
