@@ -225,7 +225,7 @@ def main(argv=None):
                    help="refuse to grade unless the submission runs isolated (bubblewrap, or root with a "
                         "dedicated uid); for official marks")
     g.add_argument("--require-full", action="store_true",
-                   help="exit 1 unless every selected test passed (for GitHub Classroom steps)")
+                   help="exit 1 unless every selected test passed")
     g.add_argument("--impl-module", action="append", default=[], metavar="MODULE=FILE",
                    help=argparse.SUPPRESS)  # mutation checks: replace one module
     b = commands.add_parser("batch", help="grade every submission in a folder, in parallel")
@@ -238,11 +238,14 @@ def main(argv=None):
                    help="grade even where submissions cannot be isolated (marks are then local checks)")
     r = commands.add_parser("release", help="write the student repository (no solutions, no hidden tests)")
     r.add_argument("out_dir", help="an empty or new folder")
+    r.add_argument("--course-repository", metavar="OWNER/NAME",
+                   help="the published student repository whose grader the students' workflow checks out "
+                        "(default: the repository variable PCL_COURSE_REPOSITORY)")
     args = parser.parse_args(argv)
     if args.command == "release":
         from grading.release import release
 
-        leaks = release(args.out_dir)
+        leaks = release(args.out_dir, args.course_repository)
         if leaks:
             print("error: the release contains reference code:\n" + "\n".join(leaks[:20]), file=sys.stderr)
             return 1

@@ -3,7 +3,7 @@
 What goes out: the stubs and helpers of ``pcl_course/``, the book sources
 with every ``{solution}`` block removed, the public graded tests, the grader
 (so that students see the same marks table), the set-up files, a student
-README and a GitHub Classroom workflow. What stays: ``solutions/``, the
+README and a GitHub Actions workflow (the advisory check). What stays: ``solutions/``, the
 project's own tests, the wrong and alternative submissions, and any hidden
 tests. The release is then scanned for the reference's code
 (:mod:`grading.leakcheck`); a match fails the release.
@@ -11,10 +11,11 @@ tests. The release is then scanned for the reference's code
 
 import re
 import shutil
-import textwrap
 from pathlib import Path
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT
+import yaml
+
+from grading import REPO_ROOT
 from grading.leakcheck import find_leaks
 
 COPIED = ["pcl_course", "grading", "tests/graded", "book", "scripts", "_toc.yml", "requirements.txt",
@@ -79,7 +80,13 @@ only, outside `pcl_course/`'s exercise modules. NumPy and SciPy (including
 `scipy.spatial.cKDTree`) are allowed. The graded run checks this.
 
 Your submission is graded with these public tests and with hidden tests of
-the same contract.
+the same contract, in a sandbox that sees nothing but your `pcl_course/`.
+
+On every push, `.github/workflows/check.yml` grades your code with a pristine
+copy of the course's grader and writes the table to the run's summary. That
+mark, like `make test`'s, is **advisory** (you control this repository and
+its CI): the official mark is the instructor's, on Gradescope or from their
+re-grade of your submission.
 """
 
 
@@ -101,73 +108,89 @@ def _student_pyproject(text):
     return re.sub(r'testpaths = \[[^\]]*\]', 'testpaths = ["tests/graded"]', text)
 
 
-def _points_per_function():
-    """Points of each graded function, from a grading run of the reference."""
-    import json
-    import tempfile
-
-    from grading import GRADED_TESTS
-    from grading.cli import points_per_function, run_graded_tests
-
-    results = Path(tempfile.mkdtemp()) / "results.json"
-    run_graded_tests(REPO_ROOT / "solutions", results, tests=GRADED_TESTS)  # the public tests only
-    return {f: maximum for f, (_, maximum) in points_per_function(json.loads(results.read_text())).items()}
+WORKFLOW_HEADER = """\
+# The advisory check: on every push, the public tests grade this repository's
+# pcl_course/ with a PRISTINE copy of the course's grader (not this
+# repository's grading/ or tests/), in its bubblewrap sandbox, and the marks
+# table goes to the run's summary. You control this repository, so this mark
+# is advisory: the official mark is the instructor's (Gradescope, or their
+# re-grade of your submission).
+"""
 
 
-def _classroom_workflow(points):
-    """A GitHub Classroom workflow: one step per graded function, passing
-    when that function gets full marks, worth that function's points."""
-    ids = [f.replace("_", "-") for f in GRADED_FUNCTIONS]
-    lines = [
-        "# GitHub Classroom: runs the public tests, one step per graded function",
-        "# (a step passes when its function gets full marks), and reports the points.",
-        "name: Autograding Tests",
-        "on: [push, workflow_dispatch, repository_dispatch]",
-        "permissions:",
-        "  checks: write",
-        "  actions: read",
-        "  contents: read",
-        "jobs:",
-        "  run-autograding-tests:",
-        "    runs-on: ubuntu-latest",
-        "    if: github.actor != 'github-classroom[bot]'",
-        "    steps:",
-        "      - uses: actions/checkout@v4",
-        "      - uses: actions/setup-python@v5",
-        "        with:",
-        '          python-version: "3.11"',
-        "      - name: Set up",
-        "        run: |",
-        "          sudo apt-get update && sudo apt-get install -y libusb-1.0-0",
-        "          python -m pip install -r requirements.txt && python -m pip install --no-deps -e .",
-    ]
-    for function, step_id in zip(GRADED_FUNCTIONS, ids):
-        # -k test_kernel_pca_ would also select test_kernel_pca_transform_...
-        longer = [g for g in GRADED_FUNCTIONS if g != function and g.startswith(function + "_")]
-        keyword = " and ".join([f"test_{function}_"] + [f"not test_{g}_" for g in longer])
-        lines += [
-            f"      - name: {function}",
-            f"        id: {step_id}",
-            "        uses: classroom-resources/autograding-command-grader@v1",
-            "        with:",
-            f"          test-name: {function}",
-            f"          command: python -m grading grade . -k '{keyword}' --require-full",
-            "          timeout: 10",
-            f"          max-score: {points.get(function, 0):g}",
-        ]
-    lines += [
-        "      - name: Autograding Reporter",
-        "        uses: classroom-resources/autograding-grading-reporter@v1",
-        "        env:",
-        *[f"          {i.upper().replace('-', '_')}_RESULTS: \"${{{{steps.{i}.outputs.result}}}}\"" for i in ids],
-        "        with:",
-        f"          runners: {','.join(ids)}",
-    ]
-    return "\n".join(lines) + "\n"
+class _WorkflowDumper(yaml.SafeDumper):
+    """``yaml.safe_dump`` with multi-line strings as literal blocks (``run: |``)."""
 
 
-def release(out_dir):
-    """Write the student repository to ``out_dir``; return the list of leaks (empty when clean)."""
+_WorkflowDumper.add_representer(
+    str, lambda dumper, text: dumper.represent_scalar("tag:yaml.org,2002:str", text,
+                                                      style="|" if "\n" in text else None))
+
+
+def _student_workflow(course_repository):
+    """A plain GitHub Actions workflow (no GitHub Classroom): the advisory check.
+
+    ``course_repository`` is the instructor's student repository
+    (``OWNER/NAME``) whose grader and public tests are checked out pristine;
+    ``None`` reads it from the repository variable ``PCL_COURSE_REPOSITORY``.
+    """
+    repository = course_repository or "${{ vars.PCL_COURSE_REPOSITORY }}"
+    grade = " ".join([
+        "python -m grading grade ../submission --require-isolation --results ../results/results.json",
+        "| tee ../results/marks.txt",
+    ])
+    summary = "\n".join([
+        "{",
+        "  echo '## Advisory marks (public tests)'",
+        "  echo",
+        "  echo 'The official mark is the instructor'\\''s re-grade (or Gradescope).'",
+        "  echo",
+        "  echo '```'",
+        "  cat ../results/marks.txt",
+        "  echo '```'",
+        '} >> "$GITHUB_STEP_SUMMARY"',
+    ])
+    workflow = {
+        "name": "Advisory check",
+        "on": {"push": None, "workflow_dispatch": None},
+        "permissions": {"contents": "read"},
+        "jobs": {"check": {
+            "runs-on": "ubuntu-24.04",
+            "timeout-minutes": 30,
+            "steps": [
+                {"name": "Check out this repository (the submission)", "uses": "actions/checkout@v4",
+                 "with": {"path": "submission"}},
+                {"name": "Check out the pristine course (its grader and public tests)",
+                 "uses": "actions/checkout@v4",
+                 "with": {"repository": repository, "ref": "${{ vars.PCL_COURSE_REF || 'main' }}",
+                          "path": "course"}},
+                {"uses": "actions/setup-python@v5", "with": {"python-version": "3.11"}},
+                {"name": "Set up (Debian packages, pinned requirements, the sandbox)",
+                 "run": "\n".join([
+                     "sudo apt-get update",
+                     "sudo apt-get install -y --no-install-recommends libusb-1.0-0 bubblewrap",
+                     "# Ubuntu 24.04 lets AppArmor forbid unprivileged user namespaces; bubblewrap needs them.",
+                     "sudo sysctl -w kernel.apparmor_restrict_unprivileged_userns=0 || true",
+                     "python -m pip install --quiet -r course/requirements.txt",
+                     "python -m pip install --quiet --no-deps -e course",
+                     "mkdir -p results",
+                 ])},
+                {"name": "Grade with the pristine grader (advisory)", "working-directory": "course",
+                 "run": f"set -o pipefail\n{grade}"},
+                {"name": "Write the marks to the summary", "if": "always()", "working-directory": "course",
+                 "run": summary},
+            ],
+        }},
+    }
+    return WORKFLOW_HEADER + yaml.dump(workflow, Dumper=_WorkflowDumper, sort_keys=False, width=120)
+
+
+def release(out_dir, course_repository=None):
+    """Write the student repository to ``out_dir``; return the list of leaks (empty when clean).
+
+    ``course_repository`` (``OWNER/NAME``) is where the students' advisory
+    workflow checks out the pristine grader; see :func:`_student_workflow`.
+    """
     out = Path(out_dir).resolve()
     if out.exists() and any(out.iterdir()):
         raise SystemExit(f"error: {out} exists and is not empty")
@@ -190,7 +213,7 @@ def release(out_dir):
     (out / "README.md").write_text(STUDENT_README)
     (out / ".ci").mkdir(exist_ok=True)
     (out / ".ci" / "run").write_text("#!/usr/bin/env bash\nset -euo pipefail\ncd \"$(dirname \"$0\")/..\"\nmake test\n")
-    workflow = out / ".github" / "workflows" / "classroom.yml"
+    workflow = out / ".github" / "workflows" / "check.yml"
     workflow.parent.mkdir(parents=True)
-    workflow.write_text(_classroom_workflow(_points_per_function()))
+    workflow.write_text(_student_workflow(course_repository))
     return find_leaks(out)

@@ -12,7 +12,7 @@ import pytest
 from sklearn.decomposition import KernelPCA
 from sklearn.metrics import pairwise
 
-from grading.checks import check_array, check_close, check_finite, check_orthonormal_columns
+from grading.checks import check_array, check_close, check_finite
 
 
 def sklearn_kernel(x, y, kernel, beta=1.0, degree=2):

@@ -10,7 +10,7 @@ import sys
 import pytest
 import yaml
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT
+from grading import REPO_ROOT
 from grading.leakcheck import find_leaks
 
 
@@ -25,7 +25,7 @@ def release_dir(tmp_path_factory):
 
 def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
     for needed in ("Makefile", "README.md", "requirements.txt", "pyproject.toml", "_config.yml", "_toc.yml",
-                   ".ci/run", ".github/workflows/classroom.yml", "scripts/system-deps.sh",
+                   ".ci/run", ".github/workflows/check.yml", "scripts/system-deps.sh",
                    "pcl_course/pca.py", "grading/cli.py", "tests/graded/test_pca.py", "book/pca.md"):
         assert (release_dir / needed).exists(), needed
     for absent in ("solutions", "tests/mutants", "tests/alternatives", "tests/project", "tests/hidden", ".git"):
@@ -68,14 +68,30 @@ def test_the_leak_check_sees_through_renaming(release_dir, tmp_path):
     assert any("chamfer_distance" in leak and "metrics.py" in leak for leak in leaks), leaks
 
 
-def test_the_classroom_workflow_grades_every_function(release_dir, reference_grading):
-    workflow = yaml.safe_load((release_dir / ".github" / "workflows" / "classroom.yml").read_text())
-    steps = [s for s in workflow["jobs"]["run-autograding-tests"]["steps"]
-             if s.get("uses", "").startswith("classroom-resources/autograding-command-grader")]
-    assert {s["with"]["test-name"] for s in steps} == set(GRADED_FUNCTIONS)
-    summary, _ = reference_grading
-    public = sum(t["max_score"] for t in summary["tests"] if "_hidden_" not in t["name"])
-    assert sum(s["with"]["max-score"] for s in steps) == public
+def test_the_workflow_grades_with_a_pristine_grader_in_the_sandbox(release_dir):
+    text = (release_dir / ".github" / "workflows" / "check.yml").read_text()
+    assert "classroom" not in text.lower()
+    workflow = yaml.safe_load(text)
+    steps = workflow["jobs"]["check"]["steps"]
+    checkouts = [s["with"] for s in steps if s.get("uses", "").startswith("actions/checkout")]
+    # The student's repository and, apart from it, the course's: its grader grades.
+    assert [c["path"] for c in checkouts] == ["submission", "course"]
+    assert checkouts[1]["repository"] == "${{ vars.PCL_COURSE_REPOSITORY }}"
+    grading = next(s for s in steps if "python -m grading grade" in s.get("run", ""))
+    assert grading["working-directory"] == "course"
+    assert "../submission" in grading["run"] and "--require-isolation" in grading["run"]
+    setup = next(s for s in steps if "apt-get install" in s.get("run", ""))
+    assert "bubblewrap" in setup["run"] and "course/requirements.txt" in setup["run"]
+    assert any("GITHUB_STEP_SUMMARY" in s.get("run", "") for s in steps)
+    assert "advisory" in text.lower()
+
+
+def test_the_workflow_names_the_course_repository_when_given(tmp_path):
+    from grading.release import _student_workflow
+
+    workflow = yaml.safe_load(_student_workflow("cs-dept/pcl-course-2027"))
+    checkout = [s for s in workflow["jobs"]["check"]["steps"] if s.get("uses", "").startswith("actions/checkout")]
+    assert checkout[1]["with"]["repository"] == "cs-dept/pcl-course-2027"
 
 
 def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
@@ -100,3 +116,27 @@ def test_the_release_book_builds_with_the_stubs(release_dir):
     assert "Not implemented yet: pca" in page
     assert "lambda_k = sigma_k^2 / N: True" not in page  # no reference results
     assert find_leaks(release_dir / "_build" / "html") == []
+
+
+def test_the_workflow_grade_step_runs_the_pristine_grader_on_the_submission(release_dir, tmp_path):
+    # The runner's workspace: the submission and the pristine course side by side.
+    workspace = tmp_path / "workspace"
+    shutil.copytree(release_dir, workspace / "course", ignore=shutil.ignore_patterns("_build", "r.json"))
+    submission = workspace / "submission"
+    shutil.copytree(release_dir / "pcl_course", submission / "pcl_course")
+    shutil.copy(REPO_ROOT / "solutions" / "metrics.py", submission / "pcl_course" / "metrics.py")
+    # A submission that tampers with its own copy of the grader changes nothing.
+    (submission / "grading").mkdir()
+    (submission / "grading" / "plugin.py").write_text("raise SystemExit('tampered')\n")
+    (workspace / "results").mkdir()
+    workflow = yaml.safe_load((release_dir / ".github" / "workflows" / "check.yml").read_text())
+    step = next(s for s in workflow["jobs"]["check"]["steps"] if "python -m grading grade" in s.get("run", ""))
+    env = dict(__import__("os").environ, PATH=f"{REPO_ROOT / '.venv' / 'bin'}:{__import__('os').environ['PATH']}")
+    completed = subprocess.run(["bash", "-e", "-c", step["run"]], cwd=workspace / step["working-directory"],
+                               capture_output=True, text=True, timeout=600, env=env)
+    assert completed.returncode == 0, completed.stdout[-2000:] + completed.stderr[-2000:]
+    summary = json.loads((workspace / "results" / "results.json").read_text())
+    metrics = [t for t in summary["tests"] if t["name"].startswith(("test_chamfer_distance_", "test_depth_metrics_"))]
+    assert metrics and all(t["status"] == "passed" for t in metrics)
+    assert summary["output"].startswith("isolated: bubblewrap")
+    assert "Total: " in (workspace / "results" / "marks.txt").read_text()

@@ -2,7 +2,6 @@
 its own calls, never the grader's process, and sees neither the reference
 nor the tests."""
 
-import os
 import shutil
 import textwrap
 
