@@ -21,6 +21,9 @@ ANSWER_LIMIT = 1024**3          # bytes of one answer the grader accepts from a 
 # these uids are taken).
 SANDBOX_UID_BASE = int(os.environ.get("PCL_SANDBOX_UID", "60500"))
 SANDBOX_UID_SLOTS = 64
+# PCL_SANDBOX_NAMESPACES=0 grades as if namespaces were forbidden (as in most
+# Docker containers): the dedicated uid and file permissions are then the wall.
+SANDBOX_NAMESPACES = os.environ.get("PCL_SANDBOX_NAMESPACES", "1") != "0"
 
 # -- staging a submission (grading/staging.py) ---------------------------------
 STAGE_MAX_FILES = 200                   # regular files in a submission's pcl_course/

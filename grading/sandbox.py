@@ -344,6 +344,54 @@ def reserve_uid(preferred=None):
     raise SandboxError(f"all {slots} sandbox uids from {base} are in use by other graders")
 
 
+def _bubblewrap_works(uid):
+    """None if a bubblewrap worker starts here for ``uid``, else why not."""
+    if not shutil.which("bwrap"):
+        return "bubblewrap (bwrap) is not installed"
+    staged = Path(tempfile.mkdtemp(prefix="grading-probe-"))
+    try:
+        os.chmod(staged, 0o711)
+        (staged / "pcl_course").mkdir(mode=0o755)
+        (staged / WORKER.name).write_text("import sys\nsys.path.append(sys.argv[1])\nimport numpy\n")
+        (staged / WORKER.name).chmod(0o644)
+        probe = _spawn(_bubblewrap_command(staged, []), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True, preexec_fn=_preexec(uid), env={})
+        _, stderr = probe.communicate(timeout=60)
+        if probe.returncode == 0:
+            return None
+        return "bubblewrap cannot run here: " + (stderr.strip().splitlines() or ["?"])[-1]
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"bubblewrap cannot run here: {exc}"
+    finally:
+        shutil.rmtree(staged, ignore_errors=True)
+        if uid is not None:
+            kill_uid(uid)
+
+
+def permission_wall(uid, protected):
+    """None if ``uid`` can run Python here but read none of ``protected``, else why not.
+
+    Run as ``uid`` itself: what it can read is measured, not inferred from
+    mode bits.
+    """
+    try:
+        completed = subprocess.run([str(_python()[0]), "-I", "-S", "-c", _probe_script(protected)],
+                                   capture_output=True, text=True, timeout=60, preexec_fn=_preexec(uid), env={},
+                                   cwd="/")
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"uid {uid} cannot run Python: {exc}"
+    finally:
+        kill_uid(uid)
+    if completed.returncode != 0:
+        return f"uid {uid} cannot use the Python environment at {sys.prefix}"
+    lines = [line for line in completed.stdout.splitlines() if line.startswith("[")]
+    readable = json.loads(lines[-1]) if lines else ["?"]
+    if readable:
+        return (f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
+                f"(chmod 700) and keep the Python environment outside it")
+    return None
+
+
 @lru_cache(maxsize=None)
 def isolation(uid=None):
     """The strongest isolation available here for the sandbox ``uid``.
@@ -357,57 +405,29 @@ def isolation(uid=None):
     Returns
     -------
     Isolation
+        ``bubblewrap`` if a worker starts in it (unless
+        :data:`grading.config.SANDBOX_NAMESPACES` is off); else ``uid`` if
+        the grader is root and the dedicated uid can read none of the
+        course's :data:`PROTECTED` folders; else ``none``, with the reasons.
     """
     root = os.geteuid() == 0
     uid = reserve_uid(uid) if root else None
     if root:
         _make_reachable(Path(sys.base_prefix) / "lib")
         _make_reachable(_site_packages())
-    reasons = []
-    if shutil.which("bwrap"):
-        staged = Path(tempfile.mkdtemp(prefix="grading-probe-"))
-        try:
-            os.chmod(staged, 0o711)
-            (staged / "pcl_course").mkdir(mode=0o755)
-            (staged / WORKER.name).write_text("import sys\nsys.path.append(sys.argv[1])\nimport numpy\n")
-            (staged / WORKER.name).chmod(0o644)
-            command = _bubblewrap_command(staged, [])
-            probe = _spawn(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                           preexec_fn=_preexec(uid), env={})
-            _, stderr = probe.communicate(timeout=60)
-            if probe.returncode == 0:
-                return Isolation(BUBBLEWRAP, uid)
-            reasons.append("bubblewrap cannot run here: " + (stderr.strip().splitlines() or ["?"])[-1])
-        except (OSError, subprocess.SubprocessError) as exc:
-            reasons.append(f"bubblewrap cannot run here: {exc}")
-        finally:
-            shutil.rmtree(staged, ignore_errors=True)
-            if uid is not None:
-                kill_uid(uid)
+    if config.SANDBOX_NAMESPACES:
+        why_not = _bubblewrap_works(uid)
+        if why_not is None:
+            return Isolation(BUBBLEWRAP, uid)
     else:
-        reasons.append("bubblewrap (bwrap) is not installed")
+        why_not = "namespaces switched off (PCL_SANDBOX_NAMESPACES=0)"
     if not root:
-        return Isolation(NONE, None, "; ".join(reasons + ["the grader is not root, so no dedicated uid"]))
+        return Isolation(NONE, None, f"{why_not}; the grader is not root, so no dedicated uid")
     # The second wall: a dedicated uid that cannot read the grader's files.
-    protected = [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()]
-    try:
-        completed = subprocess.run([str(_python()[0]), "-I", "-S", "-c", _probe_script(protected)],
-                                   capture_output=True, text=True, timeout=60, preexec_fn=_preexec(uid), env={},
-                                   cwd="/")
-    except (OSError, subprocess.SubprocessError) as exc:
-        return Isolation(NONE, None, "; ".join(reasons + [f"uid {uid} cannot run Python: {exc}"]))
-    finally:
-        kill_uid(uid)
-    if completed.returncode != 0:
-        return Isolation(NONE, None, "; ".join(reasons + [
-            f"uid {uid} cannot use the Python environment at {sys.prefix}"]))
-    lines = [line for line in completed.stdout.splitlines() if line.startswith("[")]
-    readable = json.loads(lines[-1]) if lines else ["?"]
-    if readable:
-        return Isolation(NONE, None, "; ".join(reasons + [
-            f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
-            f"(chmod 700) and keep the Python environment outside it"]))
-    return Isolation(UID, uid, "; ".join(reasons))
+    wall = permission_wall(uid, [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()])
+    if wall is not None:
+        return Isolation(NONE, None, f"{why_not}; {wall}")
+    return Isolation(UID, uid, why_not)
 
 
 def require_isolation(level):
@@ -427,15 +447,17 @@ class Worker:
     timeout : float
         Wall-clock seconds of one call, its module's import included.
     uid : int, optional
-        The dedicated sandbox uid (when the grader is root).
+        The preferred dedicated sandbox uid (when the grader is root).
+    level : Isolation, optional
+        The isolation to use (default: :func:`isolation`'s, the strongest).
     """
 
-    def __init__(self, staged_root, timeout=config.CALL_TIMEOUT, uid=None):
+    def __init__(self, staged_root, timeout=config.CALL_TIMEOUT, uid=None, level=None):
         self.staged_root = Path(staged_root).resolve()
         self.timeout = timeout
         self.process = None
         self.work = None
-        self.isolation = isolation(uid)
+        self.isolation = level if level is not None else isolation(uid)
         self.uid = self.isolation.uid
         self.broken = {}  # module -> why it cannot be imported
 
@@ -453,6 +475,11 @@ class Worker:
         _become_subreaper()
         shutil.copy(WORKER, self.staged_root / WORKER.name)
         (self.staged_root / WORKER.name).chmod(0o644)
+        if self.uid is not None:
+            # Readable by this worker's uid (Python lists the folders it imports
+            # from), by no other sandbox uid: a classmate's is out of reach.
+            os.chown(self.staged_root, 0, self.uid)
+            os.chmod(self.staged_root, 0o750)
         self.work = tempfile.mkdtemp(prefix="grading-home-")  # HOME of the uid and none levels
         if self.uid is not None:
             os.chown(self.work, self.uid, self.uid)

@@ -134,7 +134,7 @@ def stage(package_dir, into=None):
         folder, not a symbolic link.
     into : path, optional
         An empty folder of the grader's to hold the copy (default: a new
-        temporary folder, mode 0711).
+        temporary folder, mode 0700).
 
     Returns
     -------
@@ -148,7 +148,7 @@ def stage(package_dir, into=None):
     package_dir = Path(package_dir)
     root = Path(into) if into is not None else Path(tempfile.mkdtemp(prefix="grading-staged-"))
     root.mkdir(parents=True, exist_ok=True)
-    root.chmod(0o711)  # the sandbox user may pass through, not list
+    root.chmod(0o700)  # the worker opens it to its own uid only (grading/sandbox.py)
     parent_fd = _open_directory(str(package_dir.parent), None, "the submission's folder")
     try:
         info = os.stat(package_dir.name, dir_fd=parent_fd, follow_symlinks=False)

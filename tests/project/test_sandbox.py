@@ -2,6 +2,7 @@
 its own calls, never the grader's process, and sees neither the reference
 nor the tests."""
 
+import os
 import shutil
 import textwrap
 
@@ -230,3 +231,78 @@ def test_the_results_file_cannot_be_overwritten(worker, tmp_path):
     with pytest.raises((PermissionError, FileNotFoundError)):
         worker.call("evil", "overwrite", (str(results),), {})
     assert results.read_text() == '{"score": 0}'
+
+
+# -- the second wall: no namespaces, a dedicated uid and file permissions ----------------------
+
+needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="needs root (the dedicated uid)")
+
+
+@needs_root
+def test_without_namespaces_a_readable_course_is_not_isolation(tmp_path):
+    from grading.sandbox import permission_wall, reserve_uid
+
+    secret = tmp_path / "course" / "tests"
+    secret.mkdir(parents=True)
+    (secret / "test_hidden.py").write_text("EXPECTED = 42\n")
+    from grading.sandbox import _make_reachable
+
+    _make_reachable(secret)
+    why = permission_wall(reserve_uid(), [secret])
+    assert why is not None and f"can read {secret}" in why
+
+
+@needs_root
+def test_without_namespaces_the_dedicated_uid_reads_nothing_of_the_grader(tmp_path):
+    from grading.sandbox import UID, Isolation, permission_wall, reserve_uid
+
+    course = tmp_path / "course"
+    (course / "tests").mkdir(parents=True)
+    (course / "tests" / "test_hidden.py").write_text("EXPECTED = 42\n")
+    from grading.sandbox import _make_reachable
+
+    _make_reachable(course / "tests")  # the uid could reach it ...
+    uid = reserve_uid()
+    assert permission_wall(uid, [course / "tests"]) is not None
+    os.chmod(course, 0o700)  # ... until the course folder is private, as on Gradescope
+    assert permission_wall(uid, [course / "tests"]) is None
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "evil.py").write_text(
+        "import os\n"
+        "def read(path):\n    return open(path).read()\n"
+        "def whoami():\n    return os.getuid()\n")
+    worker = Worker(stage(package).root, timeout=20, level=Isolation(UID, uid, "test"))
+    try:
+        assert worker.call("evil", "whoami", (), {}) == uid
+        with pytest.raises(PermissionError):
+            worker.call("evil", "read", (str(course / "tests" / "test_hidden.py"),), {})
+    finally:
+        worker.stop()
+    from grading.sandbox import _processes
+
+    assert not [p for p in _processes() if p[3] == uid], "the uid's processes outlive its worker"
+
+
+def test_the_level_is_named_in_the_results_and_can_be_required(tmp_path):
+    import json
+    import subprocess
+    import sys
+
+    clone = tmp_path / "clone"
+    shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
+    env = {**os.environ, "PCL_SANDBOX_NAMESPACES": "0"}
+    base = [sys.executable, "-m", "grading", "grade", str(clone), "-k", "test_chamfer_distance_hand",
+            "--results", str(tmp_path / "r.json")]
+    completed = subprocess.run(base, cwd=REPO_ROOT, capture_output=True, text=True, env=env, timeout=300)
+    assert completed.returncode == 0, completed.stderr
+    # Here the course folder is readable by others: no wall, and it says so.
+    note = json.loads((tmp_path / "r.json").read_text())["output"]
+    assert note.startswith("NOT ISOLATED") and "a local check, not a mark" in note
+    assert "NOT ISOLATED" in completed.stdout.splitlines()[-2] + completed.stdout.splitlines()[-1]
+    refused = subprocess.run([*base, "--require-isolation"], cwd=REPO_ROOT, capture_output=True, text=True,
+                             env=env, timeout=300)
+    assert refused.returncode == 1
+    assert refused.stderr.startswith("error: refusing to grade: the submission could not be isolated")
+    assert len(refused.stderr.strip().splitlines()) == 1 and "Traceback" not in refused.stderr
