@@ -1,13 +1,21 @@
 """The course autograder.
 
+* :mod:`grading.cli` -- ``python -m grading grade | batch | release``.
 * :mod:`grading.plugin` -- pytest plugin: the ``impl`` fixture that hands the
   implementation under test to graded tests, points per test, per-test
   timeouts, short feedback and the results file.
-* :mod:`grading.implementation` -- loads an implementation (a student's
-  ``pcl_course/``, the reference ``solutions/``) without importing it as
-  ``pcl_course``.
+* :mod:`grading.implementation` -- the implementation under test: the
+  reference or a project mutant in-process (trusted code), a student's
+  submission staged and run in the sandbox.
+* :mod:`grading.staging` -- copies a submission's ``pcl_course/`` without
+  following links: regular files only, with caps.
+* :mod:`grading.sandbox` and :mod:`grading.worker` -- the isolated worker
+  process (bubblewrap, or a dedicated uid) and its plain-data protocol.
+* :mod:`grading.forbidden` -- the static scan for forbidden APIs.
 * :mod:`grading.checks` -- assertions with student-readable messages.
-* :mod:`grading.cli` -- ``python -m grading grade ...``.
+* :mod:`grading.config` -- every limit and constant of the grader.
+* :mod:`grading.errors` -- the grader's own exceptions.
+* :mod:`grading.release` and :mod:`grading.leakcheck` -- the student repository.
 """
 
 from pathlib import Path

@@ -92,7 +92,10 @@ class Implementation:
         if sandbox:
             # The submission runs in a worker process, never in this one, on
             # a copy staged by the grader: never where the student's files lie.
-            from grading.sandbox import Worker
+            try:
+                from grading.sandbox import Worker
+            except ImportError:  # no `resource` module: Windows
+                raise SystemExit("error: grading needs Linux or macOS (on Windows, use WSL)") from None
             from grading.staging import stage
 
             if self.overrides or self.directory.name != "pcl_course":

@@ -230,7 +230,12 @@ def _preexec(uid):
         os.setsid()  # its own process group: killed as a whole, forks included
         for limit, value in ((resource.RLIMIT_AS, config.MEMORY_LIMIT), (resource.RLIMIT_CPU, config.CPU_LIMIT),
                              (resource.RLIMIT_FSIZE, config.FILE_SIZE_LIMIT), (resource.RLIMIT_CORE, 0)):
-            resource.setrlimit(limit, (value, value))
+            try:
+                resource.setrlimit(limit, (value, value))
+            except (OSError, ValueError):
+                if sys.platform.startswith("linux"):
+                    raise
+                # macOS refuses some limits (RLIMIT_AS): never isolated there anyway
         if uid is not None:
             os.setgroups([])
             os.setgid(uid)
