@@ -1,10 +1,14 @@
 """Assertions for graded tests, with messages a student can act on.
 
-Each helper raises ``AssertionError`` whose message says what was expected
-and what came back (shapes and a few values), never a hidden answer in full.
+Each helper raises :class:`grading.errors.CheckFailed` (an ``AssertionError``)
+whose message says what was expected and what came back (shapes and a few
+values), never a hidden answer in full, and whose ``rule`` says which rule
+broke without any value: what a hidden test shows.
 """
 
 import numpy as np
+
+from grading.errors import CheckFailed
 
 _DTYPE_KINDS = {"float64": np.float64, "int64": np.int64, "bool": np.bool_}
 
@@ -24,19 +28,20 @@ def check_array(value, name, shape=None, dtype="float64"):
     ``shape`` may hold ``None`` for a free dimension. Returns ``value``.
     """
     if type(value) is not np.ndarray:
-        raise AssertionError(
+        raise CheckFailed(
             f"{name} must be a plain numpy.ndarray, got {type(value).__module__}."
             f"{type(value).__qualname__}"
         )
     if dtype is not None and value.dtype != _DTYPE_KINDS[dtype]:
-        raise AssertionError(f"{name} must have dtype {dtype}, got {value.dtype}")
+        raise CheckFailed(f"{name} must have dtype {dtype}, got {value.dtype}")
     if shape is not None:
         ok = value.ndim == len(shape) and all(
             s is None or s == v for s, v in zip(shape, value.shape)
         )
         if not ok:
             want = "(" + ", ".join("*" if s is None else str(s) for s in shape) + ")"
-            raise AssertionError(f"{name} must have shape {want}, got {value.shape}")
+            raise CheckFailed(f"{name} must have shape {want}, got {value.shape}",
+                              rule=f"{name} has the wrong shape")
     return value
 
 
@@ -45,7 +50,8 @@ def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
     actual = np.asarray(actual, dtype=float)
     expected = np.asarray(expected, dtype=float)
     if actual.shape != expected.shape:
-        raise AssertionError(f"{name}: expected shape {expected.shape}, got {actual.shape}")
+        raise CheckFailed(f"{name}: expected shape {expected.shape}, got {actual.shape}",
+                          rule=f"{name} has the wrong shape")
     if np.allclose(actual, expected, rtol=rtol, atol=atol, equal_nan=True):
         return
     error = np.abs(actual - expected)
@@ -58,7 +64,7 @@ def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
     )
     if hint:
         message += f"\n  hint: {hint}"
-    raise AssertionError(message)
+    raise CheckFailed(message, rule=f"{name} is wrong")
 
 
 def check_unit_columns_match(actual, expected, name, atol=1e-6, hint=""):
@@ -74,7 +80,7 @@ def check_unit_columns_match(actual, expected, name, atol=1e-6, hint=""):
         )
         if hint:
             message += f"\n  hint: {hint}"
-        raise AssertionError(message)
+        raise CheckFailed(message, rule=f"{name}: a column is not the expected unit vector")
 
 
 def check_finite(value, name, hint=""):
@@ -86,7 +92,7 @@ def check_finite(value, name, hint=""):
         message = f"{name} must be finite, but {bad.size} of {value.size} values are not (first at {index})"
         if hint:
             message += f"\n  hint: {hint}"
-        raise AssertionError(message)
+        raise CheckFailed(message, rule=f"{name} must be finite")
 
 
 def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
@@ -102,4 +108,4 @@ def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
         message = f"{name} must have orthonormal columns, but {what}"
         if hint:
             message += f"\n  hint: {hint}"
-        raise AssertionError(message)
+        raise CheckFailed(message, rule=f"{name} must have orthonormal columns")

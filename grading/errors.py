@@ -13,3 +13,16 @@ class SandboxError(Exception):
 class StagingError(Exception):
     """The submission cannot be staged (a symbolic link, a device, compiled
     code, too many or too large files, ...)."""
+
+
+class CheckFailed(AssertionError):
+    """A graded check failed (raised by :mod:`grading.checks`).
+
+    ``str(exc)`` is the full feedback: expected and got values, a hint.
+    :attr:`rule` says which rule broke without any value, so that a hidden
+    test can show it and withhold the rest.
+    """
+
+    def __init__(self, message, rule=None):
+        super().__init__(message)
+        self.rule = rule if rule is not None else message.splitlines()[0]

@@ -16,6 +16,9 @@ Options
 
 Markers
 -------
+``@pytest.mark.grades(name)``: the graded function the test grades (required).
+``@pytest.mark.hidden``: run by the instructors' grader only; feedback withheld.
+``@pytest.mark.interface``: tests shapes, dtypes, errors or in-place changes only.
 ``@pytest.mark.points(n)``: what the test is worth (default 1).
 ``@pytest.mark.timeout(s)``: its time limit (default :data:`DEFAULT_TIMEOUT`).
 """
@@ -27,7 +30,8 @@ from pathlib import Path
 import pytest
 
 from grading import config as grading_config
-from grading.errors import SandboxError, StagingError
+from grading import GRADED_FUNCTIONS
+from grading.errors import CheckFailed, SandboxError, StagingError
 from grading.implementation import ForbiddenAPI, Implementation, NotImplementedYet
 
 DEFAULT_TIMEOUT = 60.0  # seconds per graded test, ample for plain-loop solutions
@@ -57,6 +61,8 @@ def pytest_addoption(parser):
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "points(n): marks that a graded test is worth")
+    config.addinivalue_line("markers", "grades(function): the graded function a test grades")
+    config.addinivalue_line("markers", "hidden: a graded test run by the instructors' grader only")
     config.addinivalue_line("markers", "interface: a graded test of shapes, dtypes, errors or in-place "
                                        "changes only (a degenerate answer may pass it)")
     config.stash[_RESULTS_KEY] = {}
@@ -105,7 +111,23 @@ def _points(item):
     return float(marker.args[0]) if marker else 1.0
 
 
+def graded_function(item):
+    """The graded function a test grades: its ``@pytest.mark.grades(name)`` marker."""
+    marker = item.get_closest_marker("grades")
+    return marker.args[0] if marker and marker.args else None
+
+
+def is_hidden(item):
+    """Whether a graded test is hidden: its ``@pytest.mark.hidden`` marker."""
+    return item.get_closest_marker("hidden") is not None
+
+
 def pytest_collection_modifyitems(config, items):
+    unmarked = [item.nodeid for item in items if _is_graded(item) and graded_function(item) not in GRADED_FUNCTIONS]
+    if unmarked:
+        raise pytest.UsageError(
+            "every graded test needs @pytest.mark.grades(<a function of grading.GRADED_FUNCTIONS>): "
+            + ", ".join(unmarked[:5]))
     for item in items:
         if _is_graded(item) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(DEFAULT_TIMEOUT))
@@ -118,6 +140,31 @@ def _location_in_implementation(excinfo, impl):
         if any(path == root or root in path.parents for root in roots):
             return f"{path.name}:{entry.lineno + 1} in {entry.name}"
     return None
+
+
+def _hidden_feedback(excinfo):
+    """A hidden test's feedback: which rule broke, never a value of its inputs or answers.
+
+    The check helpers say which rule broke (:attr:`CheckFailed.rule`); the
+    grader's own messages are values-free in their first line; an exception
+    of the submission is shown by its type and place only, since its message
+    may print the hidden inputs.
+    """
+    exc = excinfo.value
+    if isinstance(exc, CheckFailed):
+        text = exc.rule
+    elif isinstance(exc, (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError)):
+        text = str(exc).splitlines()[0].split("; its last output")[0]
+    elif excinfo.typename == "Failed" and str(exc).startswith("Timeout"):
+        text = "timed out"
+    elif excinfo.typename == "Failed" and str(exc).startswith("DID NOT RAISE"):
+        text = "expected the call to raise an error, but it returned normally"
+    elif isinstance(exc, AssertionError):
+        text = "a check of the answer failed"
+    else:
+        where = getattr(exc, "where", None)
+        text = f"raised {excinfo.typename}" + (f" at {where}" if where else "")
+    return f"{text[:200]} (hidden test: details withheld)"
 
 
 def _feedback(excinfo, impl):
@@ -162,16 +209,19 @@ def pytest_runtest_makereport(item, call):
         "max_score": _points(item),
         "status": "failed",
         "output": "",
+        "tags": [graded_function(item)],
+        "visibility": "after_published" if is_hidden(item) else "visible",
     })
     if report.when == "call" and report.passed:
         entry.update(score=entry["max_score"], status="passed", output="")
     elif report.failed:
         impl = item.config.stash.get(_IMPL_KEY, None)
-        message = _feedback(call.excinfo, impl) if call.excinfo else "failed"
-        if "hidden" in Path(str(item.path)).parts:
-            # A hidden test's feedback names the failure, never the expected values.
-            message = message.splitlines()[0].split(": expected")[0].split(" expected ")[0]
-            message = f"{message[:160]} (hidden test: details withheld)"
+        if not call.excinfo:
+            message = "failed"
+        elif is_hidden(item):
+            message = _hidden_feedback(call.excinfo)
+        else:
+            message = _feedback(call.excinfo, impl)
         if report.when != "call":
             message = f"error in test {report.when}: {message}"
         entry.update(score=0.0, status="failed", output=message)

@@ -38,6 +38,7 @@ def cloud():
 
 # --- voxel_grid_downsample ------------------------------------------------------
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_voxel_grid_downsample_returns_a_float64_array(impl, cloud):
@@ -45,6 +46,7 @@ def test_voxel_grid_downsample_returns_a_float64_array(impl, cloud):
     check_array(result, "downsampled", shape=(None, 5))
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(3)
 def test_voxel_grid_downsample_centroids_in_linear_index_order(impl, cloud):
     result = impl.voxel_grid_downsample(cloud, 0.25)
@@ -57,6 +59,7 @@ def test_voxel_grid_downsample_centroids_in_linear_index_order(impl, cloud):
                 hint="one row per voxel, the mean of ALL columns, ordered by linear index (x fastest, then y, z)")
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(2)
 def test_voxel_grid_downsample_hand_built_voxels(impl):
     # Voxel size 1, minimum at (0.5, 0.5, 0.5): the origin is the minimum, not 0.
@@ -77,6 +80,7 @@ def test_voxel_grid_downsample_hand_built_voxels(impl):
     check_close(result, expected, "downsampled", hint="origin at the per-axis MINIMUM of the points")
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(2)
 def test_voxel_grid_downsample_when_the_extent_is_a_multiple_of_the_size(impl):
     # Extent exactly 2 voxels on x: the grid needs floor(2) + 1 = 3 cells, or
@@ -88,6 +92,7 @@ def test_voxel_grid_downsample_when_the_extent_is_a_multiple_of_the_size(impl):
                 hint="grid size per axis D = floor((max - min) / voxel_size) + 1")
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(3)
 def test_voxel_grid_downsample_on_a_grid_too_large_for_int64(impl):
     # D_x = D_y = 2^16 and h_z = 2^32: the linear index of the last point is
@@ -98,6 +103,7 @@ def test_voxel_grid_downsample_on_a_grid_too_large_for_int64(impl):
                 hint="4 distinct voxels; the linear index overflows int64 here: sort by (h_z, h_y, h_x) instead")
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(2)
 def test_voxel_grid_downsample_on_a_lidar_sized_grid(impl):
     # The lecture's case: 200 m x 200 m x 20 m at 5 cm is 6.4e9 voxels > 2^32.
@@ -111,6 +117,7 @@ def test_voxel_grid_downsample_on_a_lidar_sized_grid(impl):
                 hint="int32 linear indices overflow on this grid (6.4e9 voxels)")
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(3)
 def test_voxel_grid_downsample_random_picks_every_row_uniformly(impl):
     # One voxel of 4 rows: over 400 seeds each row must be picked about 100 times.
@@ -128,6 +135,7 @@ def test_voxel_grid_downsample_random_picks_every_row_uniformly(impl):
     assert counts.min() >= 60, f"rows of a voxel picked {counts.tolist()} times in 400 runs: not uniform"
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(1)
 def test_voxel_grid_downsample_random_is_reproducible(impl, cloud):
     a = impl.voxel_grid_downsample(cloud, 0.3, method="random", rng=7)
@@ -138,6 +146,7 @@ def test_voxel_grid_downsample_random_is_reproducible(impl, cloud):
     assert all(tuple(r) in rows for r in a), "method='random' must return input rows unchanged"
 
 
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_voxel_grid_downsample_empty_cloud(impl):
@@ -150,6 +159,7 @@ def test_voxel_grid_downsample_empty_cloud(impl):
     ({"voxel_size": 0.0}, "voxel_size"), ({"voxel_size": -1.0}, "voxel_size"),
     ({"method": "median"}, "method"), ({"points": np.zeros((4, 2))}, "points"),
 ], ids=["size-zero", "size-negative", "method", "width"])
+@pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.interface
 def test_voxel_grid_downsample_rejects_bad_input(impl, kwargs, name):
     arguments = {"points": np.random.default_rng(33).uniform(size=(10, 3)), "voxel_size": 0.5, **kwargs}
@@ -160,6 +170,7 @@ def test_voxel_grid_downsample_rejects_bad_input(impl, kwargs, name):
 
 # --- approximate_voxel_downsample ---------------------------------------------------
 
+@pytest.mark.grades("approximate_voxel_downsample")
 @pytest.mark.points(2)
 def test_approximate_voxel_downsample_without_conflicts_is_the_exact_filter(impl, cloud):
     # With more containers than the largest linear index, no two voxels share a
@@ -168,6 +179,7 @@ def test_approximate_voxel_downsample_without_conflicts_is_the_exact_filter(impl
     check_close(result, expected_centroids(cloud, 0.25), "approximate filter without conflicts", rtol=1e-9)
 
 
+@pytest.mark.grades("approximate_voxel_downsample")
 @pytest.mark.points(3)
 def test_approximate_voxel_downsample_hand_built_conflicts(impl):
     # Voxel size 1, D = (4, 2, 1); 3 containers. Linear index -> container:
@@ -193,6 +205,7 @@ def test_approximate_voxel_downsample_hand_built_conflicts(impl):
                 hint="on a conflict emit the container's voxel first; at the end emit containers in increasing order")
 
 
+@pytest.mark.grades("approximate_voxel_downsample")
 @pytest.mark.points(2)
 def test_approximate_voxel_downsample_with_one_container(impl):
     # One container: every change of voxel along the input emits the run so far.
@@ -207,6 +220,7 @@ def test_approximate_voxel_downsample_with_one_container(impl):
                 hint="with one container, each run of consecutive points in one voxel gives one row")
 
 
+@pytest.mark.grades("approximate_voxel_downsample")
 @pytest.mark.points(2)
 def test_approximate_voxel_downsample_hash_uses_all_three_axes(impl):
     # D = (2, 2, 2). Voxels A = (0,0,0), B = (0,1,1) and C = (1,0,0) have
@@ -219,6 +233,7 @@ def test_approximate_voxel_downsample_hash_uses_all_three_axes(impl):
                 hint="linear index h_x + h_y * D_x + h_z * D_x * D_y, then % n_containers")
 
 
+@pytest.mark.grades("approximate_voxel_downsample")
 @pytest.mark.points(2)
 def test_approximate_voxel_downsample_random_returns_rows_of_the_container(impl):
     points = np.array([[0.1, 0.1, 0.1], [0.2, 0.3, 0.4], [0.5, 0.6, 0.7], [3.5, 0.5, 0.5]])
@@ -233,6 +248,7 @@ def test_approximate_voxel_downsample_random_returns_rows_of_the_container(impl)
     assert seen == {0, 1, 2}, f"over 200 seeds only rows {sorted(seen)} of the container were ever chosen"
 
 
+@pytest.mark.grades("approximate_voxel_downsample")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_approximate_voxel_downsample_rejects_bad_input(impl):
@@ -247,6 +263,7 @@ def test_approximate_voxel_downsample_rejects_bad_input(impl):
 
 # --- farthest_point_sampling -------------------------------------------------------------
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_farthest_point_sampling_returns_int64_indices(impl, cloud):
@@ -255,6 +272,7 @@ def test_farthest_point_sampling_returns_int64_indices(impl, cloud):
     assert result[0] == 0, "the first index is start_index (default 0)"
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(2)
 def test_farthest_point_sampling_on_a_line(impl):
     x = np.array([0.0, 1.0, 3.0, 7.0, 10.0, 4.0])
@@ -269,6 +287,7 @@ def test_farthest_point_sampling_on_a_line(impl):
     )
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(2)
 def test_farthest_point_sampling_uses_the_nearest_selected_point(impl):
     # After 0 and 1, point 2 is far from point 1 (the last selected) but close
@@ -281,6 +300,7 @@ def test_farthest_point_sampling_uses_the_nearest_selected_point(impl):
     )
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(2)
 def test_farthest_point_sampling_uses_euclidean_distance(impl):
     # From the origin: (3, 3, 0) is farther in L1 (6) but nearer in L2 (4.24)
@@ -290,6 +310,7 @@ def test_farthest_point_sampling_uses_euclidean_distance(impl):
     assert result.tolist() == [0, 2], f"expected [0, 2] (Euclidean distance), got {result.tolist()}"
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(1)
 def test_farthest_point_sampling_uses_only_xyz(impl):
     points = np.array([[0.0, 0, 0, 0.0], [1.0, 0, 0, 100.0], [2.0, 0, 0, 0.0]])
@@ -297,6 +318,7 @@ def test_farthest_point_sampling_uses_only_xyz(impl):
     assert result.tolist() == [0, 2], f"extra columns must not count in the distance, got {result.tolist()}"
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(2)
 def test_farthest_point_sampling_start_index_and_ties(impl):
     # A square: from corner 2, the opposite corner 0 is farthest; then 1 and 3
@@ -308,6 +330,7 @@ def test_farthest_point_sampling_start_index_and_ties(impl):
     )
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(2)
 def test_farthest_point_sampling_never_repeats_with_duplicates(impl):
     points = np.array([[0.0, 0, 0], [0.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0], [0.5, 0, 0]])
@@ -316,6 +339,7 @@ def test_farthest_point_sampling_never_repeats_with_duplicates(impl):
     assert result[:3].tolist() == [0, 2, 4], f"expected to start [0, 2, 4], got {result.tolist()}"
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(2)
 def test_farthest_point_sampling_matches_open3d(impl):
     import open3d as o3d
@@ -329,6 +353,7 @@ def test_farthest_point_sampling_matches_open3d(impl):
     check_close(points[np.sort(result)], sampled, "selected points vs Open3D's farthest_point_down_sample")
 
 
+@pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(1)
 def test_farthest_point_sampling_extremes_and_errors(impl, cloud):
     check_array(impl.farthest_point_sampling(cloud, 0), "indices", shape=(0,), dtype="int64")
@@ -361,6 +386,7 @@ def skewed_normals():
     return normals / np.linalg.norm(normals, axis=1, keepdims=True)
 
 
+@pytest.mark.grades("normal_space_sampling")
 @pytest.mark.points(1)
 def test_normal_space_sampling_returns_distinct_int64_indices(impl, skewed_normals):
     result = impl.normal_space_sampling(skewed_normals, 200, rng=0)
@@ -369,6 +395,7 @@ def test_normal_space_sampling_returns_distinct_int64_indices(impl, skewed_norma
     assert result.min() >= 0 and result.max() < 1000
 
 
+@pytest.mark.grades("normal_space_sampling")
 @pytest.mark.points(3)
 def test_normal_space_sampling_draws_round_robin_over_buckets(impl, skewed_normals):
     ids = bucket(skewed_normals, 4)
@@ -384,6 +411,7 @@ def test_normal_space_sampling_draws_round_robin_over_buckets(impl, skewed_norma
     )
 
 
+@pytest.mark.grades("normal_space_sampling")
 @pytest.mark.points(2)
 def test_normal_space_sampling_keeps_rare_orientations(impl, skewed_normals):
     result = impl.normal_space_sampling(skewed_normals, 100, rng=2)
@@ -391,6 +419,7 @@ def test_normal_space_sampling_keeps_rare_orientations(impl, skewed_normals):
     assert up <= 40, f"{up} of 100 samples are floor normals: normal space sampling must not sample uniformly"
 
 
+@pytest.mark.grades("normal_space_sampling")
 @pytest.mark.points(2)
 def test_normal_space_sampling_is_uniform_within_a_bucket(impl):
     normals = np.tile([0.0, 0.0, 1.0], (5, 1))  # one bucket of five points
@@ -401,6 +430,7 @@ def test_normal_space_sampling_is_uniform_within_a_bucket(impl):
     assert np.array_equal(again, impl.normal_space_sampling(normals, 5, rng=4)), "same seed, same answer"
 
 
+@pytest.mark.grades("normal_space_sampling")
 @pytest.mark.points(2)
 def test_normal_space_sampling_bucket_boundaries(impl):
     # n_bins = 3. A component of exactly 1 must be clipped into the last bin:
@@ -418,6 +448,7 @@ def test_normal_space_sampling_bucket_boundaries(impl):
         )
 
 
+@pytest.mark.grades("normal_space_sampling")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_normal_space_sampling_rejects_bad_input(impl, skewed_normals):

@@ -17,6 +17,7 @@ from grading.checks import check_array, check_close
 
 # --- radius_outlier_removal ------------------------------------------------------
 
+@pytest.mark.grades("radius_outlier_removal")
 @pytest.mark.points(2)
 def test_radius_outlier_removal_counts_other_points_within_the_radius(impl):
     # On a line: 0, 1, 2 are a chain (spacing 1), 5 is alone, 10 and 10 coincide.
@@ -33,6 +34,7 @@ def test_radius_outlier_removal_counts_other_points_within_the_radius(impl):
     )
 
 
+@pytest.mark.grades("radius_outlier_removal")
 @pytest.mark.points(2)
 def test_radius_outlier_removal_matches_brute_force(impl):
     rng = np.random.default_rng(51)
@@ -42,6 +44,7 @@ def test_radius_outlier_removal_matches_brute_force(impl):
     check_close(impl.radius_outlier_removal(points, 0.5, 3), expected, "keep mask")
 
 
+@pytest.mark.grades("radius_outlier_removal")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_radius_outlier_removal_empty_and_errors(impl):
@@ -60,6 +63,7 @@ def mean_distances(points, k):
     return np.sort(d, axis=1)[:, :k].mean(axis=1)
 
 
+@pytest.mark.grades("statistical_outlier_removal")
 @pytest.mark.points(3)
 def test_statistical_outlier_removal_matches_its_definition(impl):
     rng = np.random.default_rng(52)
@@ -75,6 +79,7 @@ def test_statistical_outlier_removal_matches_its_definition(impl):
     )
 
 
+@pytest.mark.grades("statistical_outlier_removal")
 @pytest.mark.points(2)
 def test_statistical_outlier_removal_hand_built(impl):
     # Six points on a line, k = 1: nearest-other distances 1, 1, 1, 1, 1, 4.
@@ -85,6 +90,7 @@ def test_statistical_outlier_removal_hand_built(impl):
     assert keep.tolist() == [True] * 5 + [False], f"expected only the last point removed, got {keep.tolist()}"
 
 
+@pytest.mark.grades("statistical_outlier_removal")
 @pytest.mark.points(2)
 def test_statistical_outlier_removal_counts_duplicates_not_itself(impl):
     # Points 0 and 1 coincide: each is the other's nearest neighbour at 0.
@@ -98,6 +104,7 @@ def test_statistical_outlier_removal_counts_duplicates_not_itself(impl):
     )
 
 
+@pytest.mark.grades("statistical_outlier_removal")
 @pytest.mark.points(2)
 def test_statistical_outlier_removal_is_one_sided(impl):
     # A tight clump inside a sparse cloud has a mean distance far BELOW mu:
@@ -115,6 +122,7 @@ def test_statistical_outlier_removal_is_one_sided(impl):
     assert far.any() and not keep[far].any(), "points with a mean distance above mu + std_ratio * sigma go"
 
 
+@pytest.mark.grades("statistical_outlier_removal")
 @pytest.mark.points(2)
 def test_statistical_outlier_removal_uses_the_sample_standard_deviation(impl):
     # k = 1 on a line: d = 1, 1, 1, 1, 2.5. The last point's z-score is 2.0
@@ -130,6 +138,7 @@ def test_statistical_outlier_removal_uses_the_sample_standard_deviation(impl):
     )
 
 
+@pytest.mark.grades("statistical_outlier_removal")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_statistical_outlier_removal_rejects_bad_k(impl):
@@ -154,6 +163,7 @@ def bilateral_pixel(image, y, x, sigma_s, sigma_r, r):
     return num / den
 
 
+@pytest.mark.grades("bilateral_filter_image")
 @pytest.mark.points(3)
 def test_bilateral_filter_image_matches_its_formula(impl):
     image = np.random.default_rng(55).uniform(0, 1, size=(9, 11))
@@ -167,6 +177,7 @@ def test_bilateral_filter_image_matches_its_formula(impl):
         )
 
 
+@pytest.mark.grades("bilateral_filter_image")
 @pytest.mark.points(1)
 def test_bilateral_filter_image_default_radius(impl):
     image = np.random.default_rng(56).uniform(0, 1, size=(8, 8))
@@ -175,6 +186,7 @@ def test_bilateral_filter_image_default_radius(impl):
                 hint="radius=None means r = ceil(2 * sigma_s)")
 
 
+@pytest.mark.grades("bilateral_filter_image")
 @pytest.mark.points(2)
 def test_bilateral_filter_image_leaves_a_constant_image_unchanged(impl):
     image = np.full((7, 9), 5.0)
@@ -186,6 +198,7 @@ def test_bilateral_filter_image_leaves_a_constant_image_unchanged(impl):
         "with sigma_r = 10 the filter is a Gaussian blur: noise on a constant image must shrink")
 
 
+@pytest.mark.grades("bilateral_filter_image")
 @pytest.mark.points(2)
 def test_bilateral_filter_image_keeps_a_step_edge(impl):
     image = np.zeros((6, 10))
@@ -203,6 +216,7 @@ def test_bilateral_filter_image_keeps_a_step_edge(impl):
 
 # --- bilateral_filter_points ------------------------------------------------------------
 
+@pytest.mark.grades("bilateral_filter_points")
 @pytest.mark.points(2)
 def test_bilateral_filter_points_leaves_a_plane_on_its_plane(impl):
     rng = np.random.default_rng(57)
@@ -219,6 +233,7 @@ def test_bilateral_filter_points_leaves_a_plane_on_its_plane(impl):
         f"a point 0.05 above the plane must be pulled towards it, got height {result[0, 2] - 2.0:.4f}")
 
 
+@pytest.mark.grades("bilateral_filter_points")
 @pytest.mark.points(3)
 def test_bilateral_filter_points_matches_its_formula(impl):
     rng = np.random.default_rng(58)
@@ -237,6 +252,7 @@ def test_bilateral_filter_points_matches_its_formula(impl):
                     hint="p' = p + n_p * sum(w h) / sum(w), over ||q - p|| <= radius, p included")
 
 
+@pytest.mark.grades("bilateral_filter_points")
 @pytest.mark.points(2)
 def test_bilateral_filter_points_moves_only_along_the_normal(impl):
     rng = np.random.default_rng(59)
@@ -254,6 +270,7 @@ def test_bilateral_filter_points_moves_only_along_the_normal(impl):
 
 # --- joint_bilateral_upsample ----------------------------------------------------------
 
+@pytest.mark.grades("joint_bilateral_upsample")
 @pytest.mark.points(2)
 def test_joint_bilateral_upsample_hand_built(impl):
     depth = np.zeros((3, 3))
@@ -270,6 +287,7 @@ def test_joint_bilateral_upsample_hand_built(impl):
     assert result[0, 2] == 0.0, f"(0, 2): its window holds no valid pixel: expected 0, got {result[0, 2]}"
 
 
+@pytest.mark.grades("joint_bilateral_upsample")
 @pytest.mark.points(2)
 def test_joint_bilateral_upsample_follows_the_guide_edge(impl):
     # Depth 10 left of a colour edge, 20 right of it; sparse samples on both sides.
@@ -285,6 +303,7 @@ def test_joint_bilateral_upsample_follows_the_guide_edge(impl):
     )
 
 
+@pytest.mark.grades("joint_bilateral_upsample")
 @pytest.mark.points(1)
 def test_joint_bilateral_upsample_matches_its_formula(impl):
     rng = np.random.default_rng(60)

@@ -57,6 +57,7 @@ def blob():
 
 # --- kernel_matrix ---------------------------------------------------------
 
+@pytest.mark.grades("kernel_matrix")
 @pytest.mark.points(2)
 @pytest.mark.parametrize("kernel", ["linear", "polynomial", "gaussian", "laplacian"])
 def test_kernel_matrix_closed_forms(impl, kernel):
@@ -78,6 +79,7 @@ def test_kernel_matrix_closed_forms(impl, kernel):
     check_close(result, expected, f"kernel_matrix(kernel={kernel!r})", hint=hint)
 
 
+@pytest.mark.grades("kernel_matrix")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_kernel_matrix_rejects_unknown_kernel_and_bad_beta(impl):
@@ -92,6 +94,7 @@ def test_kernel_matrix_rejects_unknown_kernel_and_bad_beta(impl):
 
 # --- kernel_pca -------------------------------------------------------------
 
+@pytest.mark.grades("kernel_pca")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_kernel_pca_returns_arrays_of_the_right_shapes(impl, blob):
@@ -103,6 +106,7 @@ def test_kernel_pca_returns_arrays_of_the_right_shapes(impl, blob):
     check_array(alphas, "alphas", shape=(60, 3))
 
 
+@pytest.mark.grades("kernel_pca")
 @pytest.mark.points(3)
 @pytest.mark.parametrize("kernel", ["gaussian", "polynomial", "laplacian"])
 def test_kernel_pca_eigenvalues_match_sklearn(impl, blob, kernel):
@@ -112,6 +116,7 @@ def test_kernel_pca_eigenvalues_match_sklearn(impl, blob, kernel):
                 hint="eigenvalues of K~ = K - 1_N K - K 1_N + 1_N K 1_N, not divided by N, descending")
 
 
+@pytest.mark.grades("kernel_pca")
 @pytest.mark.points(3)
 @pytest.mark.parametrize("kernel", ["gaussian", "polynomial"])
 def test_kernel_pca_projections_match_sklearn(impl, blob, kernel):
@@ -121,6 +126,7 @@ def test_kernel_pca_projections_match_sklearn(impl, blob, kernel):
                 hint="projections = K~ @ alphas with ||alphas[:, r]||^2 = 1 / eigenvalues[r]")
 
 
+@pytest.mark.grades("kernel_pca")
 @pytest.mark.points(2)
 def test_kernel_pca_alphas_are_scaled_eigenvectors(impl, blob):
     projections, eigenvalues, alphas = impl.kernel_pca(blob, 3, kernel="gaussian", beta=0.5)
@@ -137,6 +143,7 @@ def test_kernel_pca_alphas_are_scaled_eigenvectors(impl, blob):
     check_close(projections, centred @ alphas, "projections vs K~ @ alphas", rtol=1e-6, atol=1e-9)
 
 
+@pytest.mark.grades("kernel_pca")
 @pytest.mark.points(2)
 def test_kernel_pca_with_the_linear_kernel_is_linear_pca(impl):
     rng = np.random.default_rng(22)
@@ -152,6 +159,7 @@ def test_kernel_pca_with_the_linear_kernel_is_linear_pca(impl):
                 hint="with the linear kernel the projections are the linear-PCA coordinates")
 
 
+@pytest.mark.grades("kernel_pca")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_kernel_pca_rejects_bad_n_components(impl, blob):
@@ -163,6 +171,7 @@ def test_kernel_pca_rejects_bad_n_components(impl, blob):
 
 # --- kernel_pca_transform ----------------------------------------------------
 
+@pytest.mark.grades("kernel_pca_transform")
 @pytest.mark.points(2)
 def test_kernel_pca_transform_of_the_training_points_gives_the_projections(impl, blob):
     projections, _, alphas = impl.kernel_pca(blob, 3, kernel="gaussian", beta=0.8)
@@ -171,6 +180,7 @@ def test_kernel_pca_transform_of_the_training_points_gives_the_projections(impl,
     check_close(result, projections, "kernel_pca_transform(points, points, alphas)", rtol=1e-6, atol=1e-9)
 
 
+@pytest.mark.grades("kernel_pca_transform")
 @pytest.mark.points(3)
 @pytest.mark.parametrize("kernel", ["gaussian", "laplacian"])
 def test_kernel_pca_transform_of_new_points_matches_sklearn(impl, blob, kernel):
@@ -185,6 +195,7 @@ def test_kernel_pca_transform_of_new_points_matches_sklearn(impl, blob, kernel):
                 hint="centre the new kernel rows with THEIR row means and the TRAINING K's column and grand means")
 
 
+@pytest.mark.grades("kernel_pca_transform")
 @pytest.mark.points(2)
 def test_kernel_pca_transform_of_one_new_point_with_the_linear_kernel(impl):
     rng = np.random.default_rng(24)

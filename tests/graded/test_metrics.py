@@ -6,6 +6,7 @@ import pytest
 from scipy.spatial.distance import cdist
 
 
+@pytest.mark.grades("chamfer_distance")
 @pytest.mark.points(2)
 def test_chamfer_distance_hand_computed(impl):
     a = np.array([[0.0, 0, 0], [1.0, 0, 0]])
@@ -18,6 +19,7 @@ def test_chamfer_distance_hand_computed(impl):
     )
 
 
+@pytest.mark.grades("chamfer_distance")
 @pytest.mark.points(2)
 def test_chamfer_distance_matches_brute_force(impl):
     rng = np.random.default_rng(41)
@@ -28,6 +30,7 @@ def test_chamfer_distance_matches_brute_force(impl):
     assert np.isclose(impl.chamfer_distance(b, a), expected, rtol=1e-9), "the Chamfer distance is symmetric"
 
 
+@pytest.mark.grades("chamfer_distance")
 @pytest.mark.points(1)
 def test_chamfer_distance_of_identical_sets_is_zero(impl):
     a = np.random.default_rng(42).normal(size=(50, 3))
@@ -38,6 +41,7 @@ def test_chamfer_distance_of_identical_sets_is_zero(impl):
         "a unit grid and its copy moved by 0.1 along x: 0.01 + 0.01 = 0.02")
 
 
+@pytest.mark.grades("chamfer_distance")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_chamfer_distance_rejects_bad_input(impl):
@@ -49,6 +53,7 @@ def test_chamfer_distance_rejects_bad_input(impl):
         impl.chamfer_distance(np.array([[np.nan, 0.0, 0.0]]), a)
 
 
+@pytest.mark.grades("depth_metrics")
 @pytest.mark.points(2)
 def test_depth_metrics_hand_computed(impl):
     gt = np.array([[2.0, 0.0], [4.0, 5.0]])       # metres; 0 = no ground truth
@@ -67,6 +72,7 @@ def test_depth_metrics_hand_computed(impl):
         )
 
 
+@pytest.mark.grades("depth_metrics")
 @pytest.mark.points(1)
 def test_depth_metrics_of_a_perfect_prediction(impl):
     gt = np.random.default_rng(43).uniform(1.0, 80.0, size=(20, 30))

@@ -37,6 +37,7 @@ def sphere_points(n, rng, radius=2.0, centre=(0.0, 0.0, 0.0)):
 
 # --- fit_plane -----------------------------------------------------------
 
+@pytest.mark.grades("fit_plane")
 @pytest.mark.points(2)
 def test_fit_plane_recovers_a_known_plane(impl):
     rng = np.random.default_rng(0)
@@ -53,6 +54,7 @@ def test_fit_plane_recovers_a_known_plane(impl):
     )
 
 
+@pytest.mark.grades("fit_plane")
 @pytest.mark.points(2)
 def test_fit_plane_normal_is_the_least_variance_direction_of_noisy_points(impl):
     rng = np.random.default_rng(1)
@@ -66,6 +68,7 @@ def test_fit_plane_normal_is_the_least_variance_direction_of_noisy_points(impl):
     )
 
 
+@pytest.mark.grades("fit_plane")
 @pytest.mark.points(2)
 def test_fit_plane_uses_the_weights(impl):
     rng = np.random.default_rng(2)
@@ -88,6 +91,7 @@ def test_fit_plane_uses_the_weights(impl):
 @pytest.mark.parametrize("weights", [
     "negative", "zero-sum", "wrong-length",
 ])
+@pytest.mark.grades("fit_plane")
 @pytest.mark.interface
 def test_fit_plane_rejects_bad_weights(impl, weights):
     points = np.random.default_rng(3).standard_normal((6, 3))
@@ -99,6 +103,7 @@ def test_fit_plane_rejects_bad_weights(impl, weights):
 
 # --- estimate_normals ------------------------------------------------------
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(1)
 def test_estimate_normals_returns_unit_float64_arrays(impl):
     rng = np.random.default_rng(4)
@@ -111,6 +116,7 @@ def test_estimate_normals_returns_unit_float64_arrays(impl):
     check_close(np.linalg.norm(normals, axis=1), np.ones(300), "||normals||", atol=1e-9)
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(3)
 def test_estimate_normals_of_a_whole_cloud_neighbourhood(impl):
     # With k = N every neighbourhood is the whole cloud: every normal is the
@@ -128,6 +134,7 @@ def test_estimate_normals_of_a_whole_cloud_neighbourhood(impl):
                 hint="curvature = l_min / (l_1 + l_2 + l_3)")
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_on_a_sphere_match_the_true_normals(impl):
     rng = np.random.default_rng(6)
@@ -142,6 +149,7 @@ def test_estimate_normals_on_a_sphere_match_the_true_normals(impl):
     assert np.all((curvature > 0) & (curvature < 0.05)), "curvature of a sphere patch must be small and positive"
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_on_a_plane_are_exact_and_flat(impl):
     rng = np.random.default_rng(7)
@@ -152,6 +160,7 @@ def test_estimate_normals_on_a_plane_are_exact_and_flat(impl):
     check_close(curvature, np.zeros(500), "curvature of a plane", atol=1e-9)
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_far_from_the_origin(impl):
     # One-pass covariance E[pp^T] - mu mu^T cancels catastrophically here.
@@ -167,6 +176,7 @@ def test_estimate_normals_far_from_the_origin(impl):
     )
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_neighbourhood_includes_the_point_itself(impl):
     # With k = 3 the neighbourhood of p is {p, a, b}: its plane contains p.
@@ -182,6 +192,7 @@ def test_estimate_normals_neighbourhood_includes_the_point_itself(impl):
     )
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(1)
 def test_estimate_normals_with_a_radius_is_inclusive(impl):
     points = np.array([[0.0, 0, 0], [1.0, 0, 0], [0.0, 1, 0], [5.0, 5, 5]])
@@ -194,6 +205,7 @@ def test_estimate_normals_with_a_radius_is_inclusive(impl):
     )
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_radius_neighbourhood_matches_its_definition(impl):
     rng = np.random.default_rng(10)
@@ -207,6 +219,7 @@ def test_estimate_normals_radius_neighbourhood_matches_its_definition(impl):
         assert np.isclose(curvature[i], values[0] / values.sum(), rtol=1e-6, atol=1e-12)
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_hybrid_keeps_only_the_k_nearest(impl):
     # The 9 nearest points of the centre lie on z = 0; the radius also reaches
@@ -224,6 +237,7 @@ def test_estimate_normals_hybrid_keeps_only_the_k_nearest(impl):
     assert abs_cos(normals_all[centre], [0, 0, 1]) < 0.5, "with k=None every point within the radius counts"
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(1)
 def test_estimate_normals_fewer_than_three_neighbours_give_nan(impl):
     points = np.random.default_rng(11).uniform(size=(20, 3))
@@ -237,6 +251,7 @@ def test_estimate_normals_fewer_than_three_neighbours_give_nan(impl):
     )
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_orients_towards_the_viewpoint(impl):
     rng = np.random.default_rng(12)
@@ -249,6 +264,7 @@ def test_estimate_normals_orients_towards_the_viewpoint(impl):
             assert np.all(np.sum(normals * truth, axis=1) < -0.9)
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_match_open3d(impl):
     import open3d as o3d
@@ -265,6 +281,7 @@ def test_estimate_normals_match_open3d(impl):
     )
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_estimate_normals_of_an_empty_cloud(impl):
@@ -273,6 +290,7 @@ def test_estimate_normals_of_an_empty_cloud(impl):
     check_array(curvature, "curvature", shape=(0,))
 
 
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_estimate_normals_does_not_modify_its_input(impl):
@@ -291,6 +309,7 @@ def test_estimate_normals_does_not_modify_its_input(impl):
     ({"k": 0}, "k"),
     ({"viewpoint": np.zeros(2)}, "viewpoint"),
 ], ids=["width", "nan", "radius-zero", "radius-negative", "k-zero", "viewpoint-shape"])
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.interface
 def test_estimate_normals_rejects_bad_input(impl, kwargs, name):
     arguments = {"points": np.random.default_rng(15).uniform(size=(10, 3)), "k": 5, **kwargs}

@@ -42,6 +42,7 @@ def known():
     return points, variances, rotation
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_pca_returns_plain_float64_arrays(impl, known):
@@ -54,6 +55,7 @@ def test_pca_returns_plain_float64_arrays(impl, known):
     check_array(result[1], "eigenvectors", shape=(3, 3))
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_eigenvalues_match_known_variances(impl, known):
     points, variances, _ = known
@@ -62,6 +64,7 @@ def test_pca_eigenvalues_match_known_variances(impl, known):
                 hint="centre each column on its own mean, divide by N (not N - 1), sort descending")
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_eigenvectors_are_the_principal_axes(impl, known):
     points, _, rotation = known
@@ -70,6 +73,7 @@ def test_pca_eigenvectors_are_the_principal_axes(impl, known):
                              hint="eigenvectors must be the COLUMNS, in the order of the eigenvalues")
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_columns_satisfy_the_eigen_equation(impl):
     rng = np.random.default_rng(11)
@@ -83,6 +87,7 @@ def test_pca_columns_satisfy_the_eigen_equation(impl):
                 hint="H @ eigenvectors[:, i] must equal eigenvalues[i] * eigenvectors[:, i]")
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_centres_each_column_on_its_own_mean(impl):
     rng = np.random.default_rng(3)
@@ -93,6 +98,7 @@ def test_pca_centres_each_column_on_its_own_mean(impl):
                 hint="subtract each column's own mean (points.mean(axis=0)) before forming H")
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_uses_population_normalisation(impl):
     rng = np.random.default_rng(5)
@@ -103,6 +109,7 @@ def test_pca_uses_population_normalisation(impl):
                 hint="H = X~^T X~ / N: divide by N, not N - 1")
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(1)
 def test_pca_sorts_eigenvalues_descending(impl):
     rng = np.random.default_rng(9)
@@ -116,6 +123,7 @@ def test_pca_sorts_eigenvalues_descending(impl):
     assert abs(eigenvectors[2, 0]) > 0.99, "the first column must be the axis of largest variance (z)"
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(1)
 def test_pca_unsorted_result_is_still_an_eigendecomposition(impl):
     rng = np.random.default_rng(10)
@@ -128,6 +136,7 @@ def test_pca_unsorted_result_is_still_an_eigendecomposition(impl):
     check_close(h @ eigenvectors, eigenvectors * eigenvalues, "H @ eigenvectors", atol=1e-8)
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_eigenvectors_are_orthonormal_for_repeated_eigenvalues(impl):
     rng = np.random.default_rng(12)
@@ -140,6 +149,7 @@ def test_pca_eigenvectors_are_orthonormal_for_repeated_eigenvalues(impl):
                 atol=1e-8, hint="use a symmetric eigensolver (np.linalg.eigh): H is symmetric")
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_correlation_matrix(impl):
     rng = np.random.default_rng(13)
@@ -153,6 +163,7 @@ def test_pca_correlation_matrix(impl):
     check_close(corr @ eigenvectors, eigenvectors * eigenvalues, "R @ eigenvectors", atol=1e-8)
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(1)
 def test_pca_correlation_leaves_a_constant_column_at_zero(impl):
     rng = np.random.default_rng(14)
@@ -165,6 +176,7 @@ def test_pca_correlation_leaves_a_constant_column_at_zero(impl):
     check_close(eigenvalues, [expected[0], expected[1], 0.0], "eigenvalues", atol=1e-9)
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(1)
 def test_pca_principal_axis_of_a_cylinder(impl):
     # Ground truth from geometry: a long thin cylinder's first principal axis
@@ -184,6 +196,7 @@ def test_pca_principal_axis_of_a_cylinder(impl):
     )
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(1)
 def test_pca_accepts_lists_and_other_dimensions(impl):
     points = [[0.0, 0.0], [2.0, 0.0], [0.0, 1.0], [2.0, 1.0]]  # variances 1 and 1/4
@@ -193,6 +206,7 @@ def test_pca_accepts_lists_and_other_dimensions(impl):
     check_close(eigenvalues, [1.0, 0.25], "eigenvalues")
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_pca_does_not_modify_its_input(impl, known):
@@ -209,6 +223,7 @@ def test_pca_does_not_modify_its_input(impl, known):
     (np.array([[0.0, 1.0, 2.0], [np.nan, 1.0, 0.0], [1.0, 1.0, 1.0]]), "NaN"),
     (np.array([[0.0, 1.0, 2.0], [np.inf, 1.0, 0.0], [1.0, 1.0, 1.0]]), "inf"),
 ], ids=["1d", "3d", "nan", "inf"])
+@pytest.mark.grades("pca")
 @pytest.mark.interface
 def test_pca_rejects_bad_points(impl, bad, why):
     with pytest.raises(ValueError) as excinfo:

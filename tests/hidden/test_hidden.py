@@ -7,9 +7,13 @@ import numpy as np
 import pytest
 from scipy.spatial.distance import cdist
 
-from grading.checks import check_close
+from grading.checks import check_close, check_orthonormal_columns
+
+# Run by the instructors' grader only; feedback withholds expected values.
+pytestmark = pytest.mark.hidden
 
 
+@pytest.mark.grades("pca")
 @pytest.mark.points(2)
 def test_pca_hidden_random_clouds(impl):
     rng = np.random.default_rng(2026)
@@ -18,9 +22,11 @@ def test_pca_hidden_random_clouds(impl):
         eigenvalues, eigenvectors = impl.pca(points)
         h = np.cov(points.T, bias=True)
         check_close(eigenvalues, np.sort(np.linalg.eigvalsh(h))[::-1], "eigenvalues", rtol=1e-6)
+        check_orthonormal_columns(eigenvectors, "eigenvectors")
         check_close(h @ eigenvectors, eigenvectors * eigenvalues, "H @ eigenvectors", atol=1e-7)
 
 
+@pytest.mark.grades("chamfer_distance")
 @pytest.mark.points(2)
 def test_chamfer_distance_hidden_random_sets(impl):
     rng = np.random.default_rng(2027)
@@ -29,6 +35,7 @@ def test_chamfer_distance_hidden_random_sets(impl):
     assert np.isclose(impl.chamfer_distance(a, b), d.min(1).mean() + d.min(0).mean(), rtol=1e-9)
 
 
+@pytest.mark.grades("radius_outlier_removal")
 @pytest.mark.points(2)
 def test_radius_outlier_removal_hidden_random_cloud(impl):
     rng = np.random.default_rng(2028)

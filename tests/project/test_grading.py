@@ -21,7 +21,8 @@ def test_results_file_has_the_gradescope_format(tmp_path):
     summary, _ = grade("--reference", "-k", "test_pca_", tmp_path=tmp_path)
     assert set(summary) == {"score", "max_score", "tests"}
     for test in summary["tests"]:
-        assert set(test) == {"name", "score", "max_score", "status", "output"}
+        assert set(test) == {"name", "score", "max_score", "status", "output", "tags", "visibility"}
+        assert test["tags"] == ["pca"] and test["visibility"] in ("visible", "after_published")
         assert test["status"] in ("passed", "failed")
         assert 0 <= test["score"] <= test["max_score"]
 
@@ -39,7 +40,20 @@ def test_stubs_get_zero_with_one_not_implemented_line_per_test(tmp_path):
 def test_every_graded_test_names_its_function(reference_grading):
     summary, _ = reference_grading
     for test in summary["tests"]:
-        assert any(f"test_{f}_" in test["name"] for f in GRADED_FUNCTIONS), test["name"]
+        assert len(test["tags"]) == 1 and test["tags"][0] in GRADED_FUNCTIONS, test["name"]
+    for name, function in _graded_test_functions().items():
+        marks = {m.name: m.args for m in getattr(function, "pytestmark", [])}
+        assert marks.get("grades", (None,))[0] in GRADED_FUNCTIONS, f"{name} has no grades(<function>) marker"
+
+
+def test_a_graded_test_without_its_marker_stops_the_run(tmp_path):
+    test_file = tmp_path / "test_unmarked.py"
+    test_file.write_text("def test_pca_something(impl):\n    pass\n")
+    command = [sys.executable, "-m", "pytest", str(test_file), "-c", str(REPO_ROOT / "grading" / "pytest.ini"),
+               "--rootdir", str(tmp_path), "-p", "grading.plugin", "-p", "no:cacheprovider", "-q"]
+    completed = subprocess.run(command, cwd=REPO_ROOT, capture_output=True, text=True)
+    assert completed.returncode == 4, completed.stdout + completed.stderr
+    assert "every graded test needs @pytest.mark.grades" in completed.stdout + completed.stderr
 
 
 def test_keyword_selects_one_exercise(tmp_path):
@@ -97,8 +111,8 @@ def test_hidden_tests_run_when_grading_and_withhold_their_details(tmp_path):
     summary, _ = grade("--reference", "--impl-module",
                        f"metrics={REPO_ROOT / 'tests' / 'mutants' / 'chamfer_distance' / 'unsquared.py'}",
                        "-k", "test_chamfer_distance_", tmp_path=tmp_path)
-    hidden = [t for t in summary["tests"] if "_hidden_" in t["name"]]
-    assert hidden and all(t["status"] == "failed" for t in hidden)
+    hidden = [t for t in summary["tests"] if t["visibility"] == "after_published"]
+    assert hidden and all(t["status"] == "failed" and "_hidden_" in t["name"] for t in hidden)
     assert all("hidden test: details withheld" in t["output"] and "\n" not in t["output"] for t in hidden)
 
 
@@ -146,8 +160,7 @@ def test_a_degenerate_answer_fails_every_test_of_values(function, kind, tmp_path
     module_file.write_text(source(function, GRADED_FUNCTIONS[function], kind))
     summary = grade_one_function(module_file, tmp_path)
     tests = _graded_test_functions()
-    longer = [g for g in GRADED_FUNCTIONS if g != function and g.startswith(function + "_")]
-    own = [t for t in summary["tests"] if not any(t["name"].startswith(f"test_{g}_") for g in longer)]
+    own = [t for t in summary["tests"] if t["tags"] == [function]]
     passed = [t["name"] for t in own if t["status"] == "passed"
               and not _is_interface_test(tests[t["name"].split("[")[0]])]
     assert not passed, f"a {kind} answer of {function} passes tests of values: {passed}"

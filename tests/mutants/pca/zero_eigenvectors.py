@@ -1,0 +1,11 @@
+"""Right eigenvalues, all-zero eigenvectors: H @ 0 == 0 * lambda satisfies the eigen-equation."""
+
+import numpy as np
+
+from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
+from solutions.pca import pca as _reference  # noqa: F401
+
+
+def pca(points, correlation=False, sort=True):
+    eigenvalues, eigenvectors = _reference(points, correlation=correlation, sort=sort)
+    return eigenvalues, np.zeros_like(eigenvectors)
