@@ -24,23 +24,4 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 GRADED_TESTS = REPO_ROOT / "tests" / "graded"   # public: shipped to students
 HIDDEN_TESTS = REPO_ROOT / "tests" / "hidden"   # run only by the instructors' grader
 
-# Graded function -> exercise module; every name in ../shared/course-api.md.
-GRADED_FUNCTIONS = {
-    "pca": "pca",
-    "kernel_matrix": "pca",
-    "kernel_pca": "pca",
-    "kernel_pca_transform": "pca",
-    "fit_plane": "normals",
-    "estimate_normals": "normals",
-    "voxel_grid_downsample": "downsampling",
-    "approximate_voxel_downsample": "downsampling",
-    "farthest_point_sampling": "downsampling",
-    "normal_space_sampling": "downsampling",
-    "radius_outlier_removal": "filters",
-    "statistical_outlier_removal": "filters",
-    "bilateral_filter_image": "filters",
-    "bilateral_filter_points": "filters",
-    "joint_bilateral_upsample": "filters",
-    "chamfer_distance": "metrics",
-    "depth_metrics": "metrics",
-}
+from grading.config import EXERCISE_MODULES, GRADED_FUNCTIONS, HELPER_MODULES  # noqa: E402,F401

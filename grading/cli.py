@@ -219,7 +219,7 @@ def main(argv=None):
     g.add_argument("--results", help="write the Gradescope results JSON here")
     g.add_argument("--junit", help="also write JUnit XML here")
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
-    g.add_argument("--call-timeout", type=float, help="seconds one call of a submission may take (default 30)")
+    g.add_argument("--call-timeout", type=float, help=f"seconds one call of a submission may take (default {config.CALL_TIMEOUT:g})")
     g.add_argument("--require-isolation", action="store_true",
                    help="refuse to grade unless the submission runs isolated (bubblewrap, or root with a "
                         "dedicated uid); for official marks")

@@ -6,13 +6,43 @@ modules of :mod:`grading` import them from this module.
 
 import os
 
+# -- what is graded -------------------------------------------------------------
+# Graded function -> exercise module; every name in ../shared/course-api.md.
+GRADED_FUNCTIONS = {
+    "pca": "pca",
+    "kernel_matrix": "pca",
+    "kernel_pca": "pca",
+    "kernel_pca_transform": "pca",
+    "fit_plane": "normals",
+    "estimate_normals": "normals",
+    "voxel_grid_downsample": "downsampling",
+    "approximate_voxel_downsample": "downsampling",
+    "farthest_point_sampling": "downsampling",
+    "normal_space_sampling": "downsampling",
+    "radius_outlier_removal": "filters",
+    "statistical_outlier_removal": "filters",
+    "bilateral_filter_image": "filters",
+    "bilateral_filter_points": "filters",
+    "joint_bilateral_upsample": "filters",
+    "chamfer_distance": "metrics",
+    "depth_metrics": "metrics",
+}
+EXERCISE_MODULES = tuple(dict.fromkeys(GRADED_FUNCTIONS.values()))  # pcl_course/<module>.py
+# Complete helper modules of pcl_course: they may use Open3D (data sets) and
+# are not exercises. A submission's copy is trusted only if it is unchanged.
+HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")
+
+# -- time limits ------------------------------------------------------------------
+TEST_TIMEOUT = 60.0             # seconds of one graded test (pytest-timeout), ample for plain loops
+CALL_TIMEOUT = 30.0             # wall-clock seconds of one sandboxed call (its module's import included)
+MAX_FEEDBACK_LINES = 12         # of one failed test's feedback
+
 # -- the worker process (grading/sandbox.py) ----------------------------------
 MEMORY_LIMIT = 4 * 1024**3      # bytes of address space of one worker
 CPU_LIMIT = 600                 # CPU seconds for a worker's whole life
 PROCESS_LIMIT = 256             # processes of the sandbox user (fork bombs)
 FILE_SIZE_LIMIT = 256 * 1024**2  # bytes of any one file the worker writes
 TMP_SIZE = 256 * 1024**2        # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
-CALL_TIMEOUT = 30.0             # wall-clock seconds of one call (import included)
 ANSWER_LIMIT = 1024**3          # bytes of one answer the grader accepts from a worker
 
 # The dedicated, unprivileged uids that run submissions when the grader is

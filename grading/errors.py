@@ -26,3 +26,26 @@ class CheckFailed(AssertionError):
     def __init__(self, message, rule=None):
         super().__init__(message)
         self.rule = rule if rule is not None else message.splitlines()[0]
+
+
+class NotImplementedYet(Exception):
+    """A graded function is still the stub (it raised NotImplementedError)."""
+
+    def __init__(self, function):
+        super().__init__(f"not implemented: {function}() raises NotImplementedError")
+        self.function = function
+
+
+class StudentError(Exception):
+    """The implementation under test raised an unexpected exception."""
+
+
+class ForbiddenAPI(Exception):
+    """An exercise module uses (or imports a module that uses) a forbidden API."""
+
+    def __init__(self, module, violations):
+        shown = "; ".join(str(v) for v in violations[:3])
+        super().__init__(
+            f"forbidden API in {module}.py ({shown}): write your own code; Open3D, PCL and "
+            "scikit-learn are allowed for visualisation only, outside the exercise modules"
+        )

@@ -14,7 +14,7 @@ import ast
 from dataclasses import dataclass
 from pathlib import Path
 
-from grading.config import FORBIDDEN_PACKAGES
+from grading.config import FORBIDDEN_PACKAGES, HELPER_MODULES
 
 IMPORT_FUNCTIONS = {("builtins", "__import__"), ("importlib", "import_module"), ("importlib", "__import__")}
 
@@ -93,9 +93,6 @@ def scan_file(path):
     return scan_source(Path(path).read_text(encoding="utf-8", errors="replace"), path)
 
 
-# Complete helper modules of pcl_course: they may use Open3D (data sets) and
-# are not exercises. A submission's copy is trusted only if it is unchanged.
-HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")
 
 
 def module_files(directory):

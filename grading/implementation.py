@@ -16,33 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
-from grading.errors import StagingError
+from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
 from grading.forbidden import scan_package
 
 _counter = itertools.count()
-
-
-class NotImplementedYet(Exception):
-    """A graded function is still the stub (it raised NotImplementedError)."""
-
-    def __init__(self, function):
-        super().__init__(f"not implemented: {function}() raises NotImplementedError")
-        self.function = function
-
-
-class StudentError(Exception):
-    """The implementation under test raised an unexpected exception."""
-
-
-class ForbiddenAPI(Exception):
-    """An exercise module uses (or imports a module that uses) a forbidden API."""
-
-    def __init__(self, module, violations):
-        shown = "; ".join(str(v) for v in violations[:3])
-        super().__init__(
-            f"forbidden API in {module}.py ({shown}): write your own code; Open3D, PCL and "
-            "scikit-learn are allowed for visualisation only, outside the exercise modules"
-        )
 
 
 def describe(value):

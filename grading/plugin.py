@@ -20,7 +20,7 @@ Markers
 ``@pytest.mark.hidden``: run by the instructors' grader only; feedback withheld.
 ``@pytest.mark.interface``: tests shapes, dtypes, errors or in-place changes only.
 ``@pytest.mark.points(n)``: what the test is worth (default 1).
-``@pytest.mark.timeout(s)``: its time limit (default :data:`DEFAULT_TIMEOUT`).
+``@pytest.mark.timeout(s)``: its time limit (default :data:`grading.config.TEST_TIMEOUT`).
 """
 
 import json
@@ -31,11 +31,9 @@ import pytest
 
 from grading import config as grading_config
 from grading import GRADED_FUNCTIONS
-from grading.errors import CheckFailed, SandboxError, StagingError
-from grading.implementation import ForbiddenAPI, Implementation, NotImplementedYet
+from grading.errors import CheckFailed, ForbiddenAPI, NotImplementedYet, SandboxError, StagingError
+from grading.implementation import Implementation
 
-DEFAULT_TIMEOUT = 60.0  # seconds per graded test, ample for plain-loop solutions
-MAX_FEEDBACK_LINES = 12
 
 _IMPL_KEY = pytest.StashKey[Implementation]()
 _RESULTS_KEY = pytest.StashKey[dict]()
@@ -130,7 +128,7 @@ def pytest_collection_modifyitems(config, items):
             + ", ".join(unmarked[:5]))
     for item in items:
         if _is_graded(item) and item.get_closest_marker("timeout") is None:
-            item.add_marker(pytest.mark.timeout(DEFAULT_TIMEOUT))
+            item.add_marker(pytest.mark.timeout(grading_config.TEST_TIMEOUT))
 
 
 def _location_in_implementation(excinfo, impl):
@@ -188,7 +186,7 @@ def _feedback(excinfo, impl):
         cut = next((i for i, line in enumerate(lines) if line.startswith("assert ")), None)
         if cut:
             lines = lines[:cut]
-        lines = lines[:MAX_FEEDBACK_LINES] or ["assertion failed"]
+        lines = lines[:grading_config.MAX_FEEDBACK_LINES] or ["assertion failed"]
         return "\n".join(lines) + last_call
     where = getattr(exc, "where", None) or (_location_in_implementation(excinfo, impl) if impl else None)
     where = f"\n  at {where}" if where else ""

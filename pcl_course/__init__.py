@@ -7,8 +7,6 @@ Complete helpers (use them): :mod:`validation`, :mod:`datasets`, :mod:`io`,
 :mod:`neighbors`, :mod:`plotting`, :mod:`book`.
 """
 
-EXERCISE_MODULES = ("pca", "normals", "downsampling", "filters", "metrics")
-
 import os as _os
 
 # Open3D starts a WebRTC visualiser (and prints about it) when imported in

@@ -10,7 +10,7 @@ import sys
 import pytest
 import yaml
 
-from grading import REPO_ROOT
+from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.leakcheck import find_leaks
 
 
@@ -30,7 +30,7 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
         assert (release_dir / needed).exists(), needed
     for absent in ("solutions", "tests/mutants", "tests/alternatives", "tests/project", "tests/hidden", ".git"):
         assert not (release_dir / absent).exists(), absent
-    for module in ("pca", "normals", "downsampling", "filters", "metrics"):
+    for module in EXERCISE_MODULES:
         assert (release_dir / "pcl_course" / f"{module}.py").read_bytes() == \
             (REPO_ROOT / "pcl_course" / f"{module}.py").read_bytes()
     assert "REFERENCE_PACKAGE = None" in (release_dir / "pcl_course" / "book.py").read_text()
