@@ -1,6 +1,7 @@
 # 3D Point Cloud Processing, Lecture 1: set-up, book, tests and grading.
 #   make book     set up, then build the book into _build/html
-#   make test     set up, build the book, run the whole test suite
+#   make test     set up, lint, build the book, run the whole test suite
+#   make lint     ruff check and ruff format --check (rules in pyproject.toml)
 #   make grade SUBMISSION=dir    grade a student's clone
 #   make bench    time the references against Open3D, scikit-learn and fpsample
 PYTHON ?= python3
@@ -10,7 +11,7 @@ STAMP  := $(VENV)/.setup-done
 SUBMISSION ?=
 RESULTS ?= results/results.json
 
-.PHONY: setup book notebooks test grade bench requirements clean
+.PHONY: setup lint book notebooks test grade bench requirements clean
 
 setup: $(STAMP)
 
@@ -44,7 +45,11 @@ notebooks: setup
 	    $(BIN)/jupytext --quiet --to ipynb --output _build/notebooks/$$(basename $$page .md).ipynb $$page || exit 1; \
 	done
 
-test: book notebooks
+lint: setup
+	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+
+test: lint book notebooks
 	$(BIN)/python -m pytest -n auto
 	$(BIN)/python -m pytest -n auto --dist loadfile --nbval-lax _build/notebooks
 

@@ -55,8 +55,10 @@ def _voxel_cases(method, dataset, n):
 
         xyz = cloud(dataset, n)
         legacy, tensor = _legacy(xyz), _tensor(xyz)
-        impls = {"reference": lambda: voxel_grid_downsample(xyz, voxel, method=method, rng=0),
-                 "open3d": lambda: legacy.voxel_down_sample(voxel)}
+        impls = {
+            "reference": lambda: voxel_grid_downsample(xyz, voxel, method=method, rng=0),
+            "open3d": lambda: legacy.voxel_down_sample(voxel),
+        }
         if method == "centroid":
             impls["open3d-tensor"] = lambda: tensor.voxel_down_sample(voxel)
         return impls
@@ -73,12 +75,21 @@ def _approximate_voxel_case(dataset, n):
         from solutions.downsampling import approximate_voxel_downsample, voxel_grid_downsample
 
         xyz = cloud(dataset, n)
-        return {"reference": lambda: approximate_voxel_downsample(xyz, voxel, containers),
-                "exact filter (reference)": lambda: voxel_grid_downsample(xyz, voxel)}
+        return {
+            "reference": lambda: approximate_voxel_downsample(xyz, voxel, containers),
+            "exact filter (reference)": lambda: voxel_grid_downsample(xyz, voxel),
+        }
 
     target = ("exact filter (reference)", 2.0) if n == 1_000_000 else None
-    return Case("approximate_voxel_downsample", "centroid", dataset, n, make,
-                {"voxel_size": voxel, "n_containers": containers}, target)
+    return Case(
+        "approximate_voxel_downsample",
+        "centroid",
+        dataset,
+        n,
+        make,
+        {"voxel_size": voxel, "n_containers": containers},
+        target,
+    )
 
 
 def _normals_case(dataset, n):
@@ -88,9 +99,11 @@ def _normals_case(dataset, n):
         xyz = cloud(dataset, n)
         legacy, tensor = _legacy(xyz), _tensor(xyz)
         knn = o3d.geometry.KDTreeSearchParamKNN(30)
-        return {"reference": lambda: estimate_normals(xyz, k=30),
-                "open3d": lambda: legacy.estimate_normals(knn),
-                "open3d-tensor": lambda: tensor.estimate_normals(max_nn=30)}
+        return {
+            "reference": lambda: estimate_normals(xyz, k=30),
+            "open3d": lambda: legacy.estimate_normals(knn),
+            "open3d-tensor": lambda: tensor.estimate_normals(max_nn=30),
+        }
 
     target = ("open3d", 1.0) if n == 100_000 else None
     return Case("estimate_normals", "knn30", dataset, n, make, {"k": 30}, target)
@@ -106,9 +119,11 @@ def _fps_case(dataset, n):
 
         xyz = cloud(dataset, n)
         legacy, tensor = _legacy(xyz), _tensor(xyz)
-        impls = {"reference": lambda: farthest_point_sampling(xyz, m),
-                 "open3d": lambda: legacy.farthest_point_down_sample(m),
-                 "fpsample-bucket": lambda: fpsample.bucket_fps_kdline_sampling(xyz, m, h=7, start_idx=0)}
+        impls = {
+            "reference": lambda: farthest_point_sampling(xyz, m),
+            "open3d": lambda: legacy.farthest_point_down_sample(m),
+            "fpsample-bucket": lambda: fpsample.bucket_fps_kdline_sampling(xyz, m, h=7, start_idx=0),
+        }
         if n < 1_000_000:  # the plain O(N M) loop: about a minute per call at a million points
             impls["fpsample-plain"] = lambda: fpsample.fps_sampling(xyz, m, start_idx=0)
         if n < 100_000:  # one tensor operation per sample: 0.2 s for 1024 of 2000 points, minutes beyond
@@ -126,9 +141,11 @@ def _sor_case(dataset, n):
         xyz = cloud(dataset, n)
         legacy, tensor = _legacy(xyz), _tensor(xyz)
         # Open3D counts the point itself among its nb_neighbors: k + 1.
-        return {"reference": lambda: statistical_outlier_removal(xyz, 20, 2.0),
-                "open3d": lambda: legacy.remove_statistical_outlier(21, 2.0),
-                "open3d-tensor": lambda: tensor.remove_statistical_outliers(21, 2.0)}
+        return {
+            "reference": lambda: statistical_outlier_removal(xyz, 20, 2.0),
+            "open3d": lambda: legacy.remove_statistical_outlier(21, 2.0),
+            "open3d-tensor": lambda: tensor.remove_statistical_outliers(21, 2.0),
+        }
 
     target = ("open3d", 1.0) if n == 100_000 else None
     return Case("statistical_outlier_removal", "k20", dataset, n, make, {"k": 20, "std_ratio": 2.0}, target)
@@ -143,9 +160,11 @@ def _ror_case(dataset, n):
         xyz = cloud(dataset, n)
         legacy, tensor = _legacy(xyz), _tensor(xyz)
         # Open3D's tensor filter counts the point itself: m + 1.
-        return {"reference": lambda: radius_outlier_removal(xyz, radius, 8),
-                "open3d": lambda: legacy.remove_radius_outlier(8, radius),
-                "open3d-tensor": lambda: tensor.remove_radius_outliers(9, radius)}
+        return {
+            "reference": lambda: radius_outlier_removal(xyz, radius, 8),
+            "open3d": lambda: legacy.remove_radius_outlier(8, radius),
+            "open3d-tensor": lambda: tensor.remove_radius_outliers(9, radius),
+        }
 
     target = ("open3d", 1.0) if n == 100_000 else None
     return Case("radius_outlier_removal", "m8", dataset, n, make, {"radius": radius, "min_neighbors": 8}, target)
@@ -160,8 +179,10 @@ def _kernel_pca_case(dataset, n):
         from solutions.pca import kernel_pca
 
         xyz = cloud(dataset, n)
-        return {"reference": lambda: kernel_pca(xyz, 2, "gaussian", beta=beta),
-                "scikit-learn": lambda: KernelPCA(2, kernel="rbf", gamma=beta).fit_transform(xyz)}
+        return {
+            "reference": lambda: kernel_pca(xyz, 2, "gaussian", beta=beta),
+            "scikit-learn": lambda: KernelPCA(2, kernel="rbf", gamma=beta).fit_transform(xyz),
+        }
 
     target = ("scikit-learn", 1.0) if n == 2000 else None
     return Case("kernel_pca", "gaussian2", dataset, n, make, {"n_components": 2, "beta": beta}, target)
@@ -174,8 +195,10 @@ def _kernel_matrix_case(n):
         from solutions.pca import kernel_matrix
 
         xyz = cloud("cube", n)
-        return {"reference": lambda: kernel_matrix(xyz, xyz, "gaussian", beta=10.0),
-                "scikit-learn": lambda: rbf_kernel(xyz, xyz, gamma=10.0)}
+        return {
+            "reference": lambda: kernel_matrix(xyz, xyz, "gaussian", beta=10.0),
+            "scikit-learn": lambda: rbf_kernel(xyz, xyz, gamma=10.0),
+        }
 
     return Case("kernel_matrix", "gaussian", "cube", n, make, {"beta": 10.0})
 
@@ -215,9 +238,15 @@ def all_cases(sizes=SIZES, kernel_sizes=KERNEL_SIZES, datasets=DATASETS):
     cases = []
     for dataset in datasets:
         for n in sizes:
-            cases += [_voxel_cases("centroid", dataset, n), _voxel_cases("random", dataset, n),
-                      _approximate_voxel_case(dataset, n), _normals_case(dataset, n), _fps_case(dataset, n),
-                      _sor_case(dataset, n), _ror_case(dataset, n)]
+            cases += [
+                _voxel_cases("centroid", dataset, n),
+                _voxel_cases("random", dataset, n),
+                _approximate_voxel_case(dataset, n),
+                _normals_case(dataset, n),
+                _fps_case(dataset, n),
+                _sor_case(dataset, n),
+                _ror_case(dataset, n),
+            ]
     for dataset in (d for d in datasets if d != "scan"):
         cases += [_kernel_pca_case(dataset, n) for n in kernel_sizes]
     cases += [_kernel_matrix_case(n) for n in kernel_sizes]

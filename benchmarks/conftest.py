@@ -12,7 +12,7 @@ import ctypes
 import gc
 import time
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import pytest
 
@@ -23,12 +23,17 @@ from benchmarks.inputs import DATASETS
 def pytest_addoption(parser):
     group = parser.getgroup("course benchmarks")
     group.addoption("--bench-sizes", default=",".join(map(str, SIZES)), help="point counts, comma-separated")
-    group.addoption("--bench-kernel-sizes", default=",".join(map(str, KERNEL_SIZES)),
-                    help="point counts of the O(N^2) kernel cases")
+    group.addoption(
+        "--bench-kernel-sizes", default=",".join(map(str, KERNEL_SIZES)), help="point counts of the O(N^2) kernel cases"
+    )
     group.addoption("--bench-datasets", default=",".join(DATASETS), help="cloud kinds: cube, shape, scan")
     group.addoption("--bench-blocks", type=int, default=3, help="alternating blocks per case")
-    group.addoption("--bench-block-seconds", type=float, default=0.6,
-                    help="aim for this much timing per implementation and block (1 to 15 rounds)")
+    group.addoption(
+        "--bench-block-seconds",
+        type=float,
+        default=0.6,
+        help="aim for this much timing per implementation and block (1 to 15 rounds)",
+    )
 
 
 def _ints(text):
@@ -39,8 +44,11 @@ def pytest_generate_tests(metafunc):
     if "bench_item" not in metafunc.fixturenames:
         return
     option = metafunc.config.getoption
-    cases = all_cases(sizes=_ints(option("--bench-sizes")), kernel_sizes=_ints(option("--bench-kernel-sizes")),
-                      datasets=tuple(option("--bench-datasets").split(",")))
+    cases = all_cases(
+        sizes=_ints(option("--bench-sizes")),
+        kernel_sizes=_ints(option("--bench-kernel-sizes")),
+        datasets=tuple(option("--bench-datasets").split(",")),
+    )
     items, ids = [], []
     for case in cases:
         for block in range(option("--bench-blocks")):
@@ -50,7 +58,7 @@ def pytest_generate_tests(metafunc):
     metafunc.parametrize("bench_item", items, ids=ids)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _names_by_case(case_id, case):
     return tuple(case.make())
 

@@ -13,7 +13,7 @@ Scale-dependent parameters (search radius, voxel size) come from the cloud
 itself, so that every size and kind asks for a comparable neighbourhood.
 """
 
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -24,7 +24,7 @@ DATASETS = ("cube", "shape", "scan")
 SCAN_POINTS_AT_1800 = 114_747  # points of simulate_lidar_scan(0) at its default 1800 azimuths
 
 
-@lru_cache(maxsize=None)
+@cache
 def cloud(dataset, n_points):
     """A read-only ``(N, 3)`` float64 cloud of about ``n_points`` points (exactly, except ``scan``)."""
     if dataset == "cube":
@@ -42,7 +42,7 @@ def cloud(dataset, n_points):
     return xyz
 
 
-@lru_cache(maxsize=None)
+@cache
 def neighbourhood_radius(dataset, n_points, k=16):
     """Median distance from a point to its k-th nearest neighbour (over 2000 sampled points)."""
     xyz = cloud(dataset, n_points)

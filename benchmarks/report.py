@@ -142,9 +142,13 @@ def markdown(results):
                 f"| {_ms(r['reference']['median_s'])} | {_ms(r[target['peer']]['median_s'])} "
                 f"| {target['ratio']:.2f} | <= {target['limit']:g} | {'yes' if target['met'] else '**no**'} |"
             )
-    lines += ["", "## All cases", "",
-              "| function | cloud | N | implementation | median (ms) | IQR (ms) | rounds | peak (MiB) | ratio ref/this |",
-              "|---|---|---:|---|---:|---:|---:|---:|---:|"]
+    lines += [
+        "",
+        "## All cases",
+        "",
+        "| function | cloud | N | implementation | median (ms) | IQR (ms) | rounds | peak (MiB) | ratio ref/this |",
+        "|---|---|---:|---|---:|---:|---:|---:|---:|",
+    ]
     for case in results["cases"]:
         for name, r in case["results"].items():
             ratio = "" if name == "reference" else f"{case['ratios'][name]:.2f}"
@@ -174,8 +178,10 @@ def main(argv=None):
     for case in results["cases"]:
         if case.get("target"):
             t = case["target"]
-            print(f"{case['case']}: ratio {t['ratio']:.2f} vs {t['peer']} (target <= {t['limit']:g}) "
-                  f"{'met' if t['met'] else 'NOT MET'}")
+            print(
+                f"{case['case']}: ratio {t['ratio']:.2f} vs {t['peer']} (target <= {t['limit']:g}) "
+                f"{'met' if t['met'] else 'NOT MET'}"
+            )
     print(f"wrote {out / 'results.json'} and {out / 'results.md'}; {len(missed)} target(s) not met")
     return 0
 

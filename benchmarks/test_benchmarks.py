@@ -10,9 +10,17 @@ def test_benchmark(benchmark, bench_item, calibrate):
     calibration = calibrate(case, name, function)
     benchmark.group = case.id
     benchmark.extra_info.update(
-        case=case.id, function=case.function, variant=case.variant, dataset=case.dataset,
-        n_points=int(case.n_points), actual_points=len(cloud(case.dataset, case.n_points)), parameters=case.parameters, implementation=name, block=block,
-        peak_bytes=calibration.peak_bytes, memory_method=calibration.memory_method,
+        case=case.id,
+        function=case.function,
+        variant=case.variant,
+        dataset=case.dataset,
+        n_points=int(case.n_points),
+        actual_points=len(cloud(case.dataset, case.n_points)),
+        parameters=case.parameters,
+        implementation=name,
+        block=block,
+        peak_bytes=calibration.peak_bytes,
+        memory_method=calibration.memory_method,
         target=list(case.target) if case.target else None,
     )
     benchmark.pedantic(function, rounds=calibration.rounds, iterations=1, warmup_rounds=0)

@@ -29,19 +29,15 @@ def check_array(value, name, shape=None, dtype="float64"):
     """
     if type(value) is not np.ndarray:
         raise CheckFailed(
-            f"{name} must be a plain numpy.ndarray, got {type(value).__module__}."
-            f"{type(value).__qualname__}"
+            f"{name} must be a plain numpy.ndarray, got {type(value).__module__}.{type(value).__qualname__}"
         )
     if dtype is not None and value.dtype != _DTYPE_KINDS[dtype]:
         raise CheckFailed(f"{name} must have dtype {dtype}, got {value.dtype}")
     if shape is not None:
-        ok = value.ndim == len(shape) and all(
-            s is None or s == v for s, v in zip(shape, value.shape)
-        )
+        ok = value.ndim == len(shape) and all(s is None or s == v for s, v in zip(shape, value.shape))
         if not ok:
             want = "(" + ", ".join("*" if s is None else str(s) for s in shape) + ")"
-            raise CheckFailed(f"{name} must have shape {want}, got {value.shape}",
-                              rule=f"{name} has the wrong shape")
+            raise CheckFailed(f"{name} must have shape {want}, got {value.shape}", rule=f"{name} has the wrong shape")
     return value
 
 
@@ -50,8 +46,9 @@ def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
     actual = np.asarray(actual, dtype=float)
     expected = np.asarray(expected, dtype=float)
     if actual.shape != expected.shape:
-        raise CheckFailed(f"{name}: expected shape {expected.shape}, got {actual.shape}",
-                          rule=f"{name} has the wrong shape")
+        raise CheckFailed(
+            f"{name}: expected shape {expected.shape}, got {actual.shape}", rule=f"{name} has the wrong shape"
+        )
     if np.allclose(actual, expected, rtol=rtol, atol=atol, equal_nan=True):
         return
     error = np.abs(actual - expected)
@@ -103,8 +100,11 @@ def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
     error = np.abs(gram - np.eye(gram.shape[0]))
     if error.max() > atol:
         i, j = (int(k) for k in np.unravel_index(np.argmax(error), error.shape))
-        what = f"column {i} has norm {np.sqrt(gram[i, i]):.6g}" if i == j else \
-            f"columns {i} and {j} have dot product {gram[i, j]:.6g}"
+        what = (
+            f"column {i} has norm {np.sqrt(gram[i, i]):.6g}"
+            if i == j
+            else f"columns {i} and {j} have dot product {gram[i, j]:.6g}"
+        )
         message = f"{name} must have orthonormal columns, but {what}"
         if hint:
             message += f"\n  hint: {hint}"

@@ -48,19 +48,45 @@ def find_package(submission):
     raise SystemExit(f"error: no pcl_course/ package found in {submission}")
 
 
-def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), tests=None, sandbox=False,
-                     call_timeout=None, require_isolation=False, sandbox_uid=None):
+def run_graded_tests(
+    impl_dir,
+    results,
+    keyword=None,
+    junit=None,
+    overrides=(),
+    tests=None,
+    sandbox=False,
+    call_timeout=None,
+    require_isolation=False,
+    sandbox_uid=None,
+):
     """Run the graded tests on ``impl_dir``; return pytest's exit code."""
     if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
         tests = [d for d in (GRADED_TESTS, HIDDEN_TESTS) if d.is_dir()]
     command = [
-        sys.executable, "-m", "pytest", *[str(t) for t in (tests if isinstance(tests, list) else [tests])],
+        sys.executable,
+        "-m",
+        "pytest",
+        *[str(t) for t in (tests if isinstance(tests, list) else [tests])],
         # The grader's own configuration only: nothing from the submission.
-        "-c", str(REPO_ROOT / "grading" / "pytest.ini"),
-        "--rootdir", str(REPO_ROOT),
-        "-p", "grading.plugin", "-p", "no:cacheprovider", "-p", "no:dash",
-        "--impl", str(impl_dir), "--results", str(results),
-        "-q", "--tb=no", "--no-header", "-rN",
+        "-c",
+        str(REPO_ROOT / "grading" / "pytest.ini"),
+        "--rootdir",
+        str(REPO_ROOT),
+        "-p",
+        "grading.plugin",
+        "-p",
+        "no:cacheprovider",
+        "-p",
+        "no:dash",
+        "--impl",
+        str(impl_dir),
+        "--results",
+        str(results),
+        "-q",
+        "--tb=no",
+        "--no-header",
+        "-rN",
     ]
     for override in overrides:
         command += ["--impl-module", override]
@@ -77,8 +103,9 @@ def run_graded_tests(impl_dir, results, keyword=None, junit=None, overrides=(), 
     if junit:
         command += ["--junitxml", str(junit)]
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
-    completed = subprocess.run(command, cwd=REPO_ROOT, env=env,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    completed = subprocess.run(
+        command, cwd=REPO_ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
     return completed.returncode, completed.stdout
 
 
@@ -89,10 +116,7 @@ def format_report(summary, title):
         status = "ok  " if test["status"] == "passed" else "FAIL"
         output = test["output"].splitlines()
         first = f"  {output[0]}" if output else ""
-        lines.append(
-            f"{test['score']:5.1f}/{test['max_score']:<4.1f} {status} "
-            f"{test['name']:<{width}}{first}".rstrip()
-        )
+        lines.append(f"{test['score']:5.1f}/{test['max_score']:<4.1f} {status} {test['name']:<{width}}{first}".rstrip())
         lines.extend(" " * (width + 17) + "  " + line for line in output[1:])
     lines += ["", f"Total: {summary['score']:g} / {summary['max_score']:g}"]
     if summary.get("output"):
@@ -116,11 +140,18 @@ def grade(args):
 
         level = isolation()
         if not level.isolated:
-            print(f"error: refusing to grade: the submission could not be isolated ({level.reason})",
-                  file=sys.stderr)
+            print(f"error: refusing to grade: the submission could not be isolated ({level.reason})", file=sys.stderr)
             return 1
-    code, output = run_graded_tests(impl_dir, results, args.k, args.junit, args.impl_module, sandbox=sandbox,
-                                    call_timeout=args.call_timeout, require_isolation=args.require_isolation)
+    code, output = run_graded_tests(
+        impl_dir,
+        results,
+        args.k,
+        args.junit,
+        args.impl_module,
+        sandbox=sandbox,
+        call_timeout=args.call_timeout,
+        require_isolation=args.require_isolation,
+    )
     if code == PYTEST_EXIT_NO_TESTS:
         print(f"error: no graded test matches -k {args.k!r}", file=sys.stderr)
         return 2
@@ -136,7 +167,6 @@ def grade(args):
     if args.require_full and summary["score"] < summary["max_score"]:
         return 1
     return 0
-
 
 
 def points_per_function(summary):
@@ -164,8 +194,10 @@ def batch(args):
 
         level = isolation()
         if not level.isolated:
-            raise SystemExit(f"error: refusing to grade the class: submissions could not be isolated "
-                             f"({level.reason}); --allow-unisolated grades anyway, as a local check")
+            raise SystemExit(
+                f"error: refusing to grade the class: submissions could not be isolated "
+                f"({level.reason}); --allow-unisolated grades anyway, as a local check"
+            )
     # One dedicated sandbox uid per parallel slot: two submissions graded at
     # once never share a uid, and whatever one left running is killed before
     # its slot grades the next.
@@ -177,8 +209,9 @@ def batch(args):
         results = out / f"{submission.name}.json"
         uid = slots.get()
         try:
-            code, output = run_graded_tests(submission / "pcl_course", results, args.k, sandbox=True,
-                                            require_isolation=require, sandbox_uid=uid)
+            code, output = run_graded_tests(
+                submission / "pcl_course", results, args.k, sandbox=True, require_isolation=require, sandbox_uid=uid
+            )
         finally:
             slots.put(uid)
         if code not in (0, 1) or not results.exists():
@@ -199,8 +232,15 @@ def batch(args):
                 writer.writerow([name, 0, "", "grading failed", *[""] * len(functions)])
                 continue
             per_function = points_per_function(summary)
-            writer.writerow([name, f"{summary['score']:g}", f"{summary['max_score']:g}", "graded",
-                             *[f"{per_function.get(f, (0, 0))[0]:g}" for f in functions]])
+            writer.writerow(
+                [
+                    name,
+                    f"{summary['score']:g}",
+                    f"{summary['max_score']:g}",
+                    "graded",
+                    *[f"{per_function.get(f, (0, 0))[0]:g}" for f in functions],
+                ]
+            )
     for name, summary, output in graded:
         mark = f"{summary['score']:g} / {summary['max_score']:g}" if summary else "grading failed"
         print(f"{name}: {mark}")
@@ -219,27 +259,40 @@ def main(argv=None):
     g.add_argument("--results", help="write the Gradescope results JSON here")
     g.add_argument("--junit", help="also write JUnit XML here")
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
-    g.add_argument("--call-timeout", type=float, help=f"seconds one call of a submission may take (default {config.CALL_TIMEOUT:g})")
-    g.add_argument("--require-isolation", action="store_true",
-                   help="refuse to grade unless the submission runs isolated (bubblewrap, or root with a "
-                        "dedicated uid); for official marks")
-    g.add_argument("--require-full", action="store_true",
-                   help="exit 1 unless every selected test passed")
-    g.add_argument("--impl-module", action="append", default=[], metavar="MODULE=FILE",
-                   help=argparse.SUPPRESS)  # mutation checks: replace one module
+    g.add_argument(
+        "--call-timeout",
+        type=float,
+        help=f"seconds one call of a submission may take (default {config.CALL_TIMEOUT:g})",
+    )
+    g.add_argument(
+        "--require-isolation",
+        action="store_true",
+        help="refuse to grade unless the submission runs isolated (bubblewrap, or root with a "
+        "dedicated uid); for official marks",
+    )
+    g.add_argument("--require-full", action="store_true", help="exit 1 unless every selected test passed")
+    g.add_argument(
+        "--impl-module", action="append", default=[], metavar="MODULE=FILE", help=argparse.SUPPRESS
+    )  # mutation checks: replace one module
     b = commands.add_parser("batch", help="grade every submission in a folder, in parallel")
     b.add_argument("directory", help="a folder with one student clone (holding pcl_course/) per subdirectory")
     b.add_argument("--csv", help="where to write the marks (default: OUT/marks.csv)")
     b.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
     b.add_argument("--jobs", type=int, help="submissions graded at once (default: number of cores)")
     b.add_argument("-k", help="select tests as pytest -k does")
-    b.add_argument("--allow-unisolated", action="store_true",
-                   help="grade even where submissions cannot be isolated (marks are then local checks)")
+    b.add_argument(
+        "--allow-unisolated",
+        action="store_true",
+        help="grade even where submissions cannot be isolated (marks are then local checks)",
+    )
     r = commands.add_parser("release", help="write the student repository (no solutions, no hidden tests)")
     r.add_argument("out_dir", help="an empty or new folder")
-    r.add_argument("--course-repository", metavar="OWNER/NAME",
-                   help="the published student repository whose grader the students' workflow checks out "
-                        "(default: the repository variable PCL_COURSE_REPOSITORY)")
+    r.add_argument(
+        "--course-repository",
+        metavar="OWNER/NAME",
+        help="the published student repository whose grader the students' workflow checks out "
+        "(default: the repository variable PCL_COURSE_REPOSITORY)",
+    )
     args = parser.parse_args(argv)
     if args.command == "release":
         from grading.release import release

@@ -33,17 +33,17 @@ EXERCISE_MODULES = tuple(dict.fromkeys(GRADED_FUNCTIONS.values()))  # pcl_course
 HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")
 
 # -- time limits ------------------------------------------------------------------
-TEST_TIMEOUT = 60.0             # seconds of one graded test (pytest-timeout), ample for plain loops
-CALL_TIMEOUT = 30.0             # wall-clock seconds of one sandboxed call (its module's import included)
-MAX_FEEDBACK_LINES = 12         # of one failed test's feedback
+TEST_TIMEOUT = 60.0  # seconds of one graded test (pytest-timeout), ample for plain loops
+CALL_TIMEOUT = 30.0  # wall-clock seconds of one sandboxed call (its module's import included)
+MAX_FEEDBACK_LINES = 12  # of one failed test's feedback
 
 # -- the worker process (grading/sandbox.py) ----------------------------------
-MEMORY_LIMIT = 4 * 1024**3      # bytes of address space of one worker
-CPU_LIMIT = 600                 # CPU seconds for a worker's whole life
-PROCESS_LIMIT = 256             # processes of the sandbox user (fork bombs)
+MEMORY_LIMIT = 4 * 1024**3  # bytes of address space of one worker
+CPU_LIMIT = 600  # CPU seconds for a worker's whole life
+PROCESS_LIMIT = 256  # processes of the sandbox user (fork bombs)
 FILE_SIZE_LIMIT = 256 * 1024**2  # bytes of any one file the worker writes
-TMP_SIZE = 256 * 1024**2        # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
-ANSWER_LIMIT = 1024**3          # bytes of one answer the grader accepts from a worker
+TMP_SIZE = 256 * 1024**2  # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
+ANSWER_LIMIT = 1024**3  # bytes of one answer the grader accepts from a worker
 
 # The dedicated, unprivileged uids that run submissions when the grader is
 # root: one per parallel job slot of `batch`, never shared with another
@@ -56,10 +56,10 @@ SANDBOX_UID_SLOTS = 64
 SANDBOX_NAMESPACES = os.environ.get("PCL_SANDBOX_NAMESPACES", "1") != "0"
 
 # -- staging a submission (grading/staging.py) ---------------------------------
-STAGE_MAX_FILES = 200                   # regular files in a submission's pcl_course/
-STAGE_MAX_FILE_BYTES = 4 * 1024**2      # bytes of one file
-STAGE_MAX_TOTAL_BYTES = 16 * 1024**2    # bytes of all files together
-STAGE_MAX_DEPTH = 8                     # nested folders
+STAGE_MAX_FILES = 200  # regular files in a submission's pcl_course/
+STAGE_MAX_FILE_BYTES = 4 * 1024**2  # bytes of one file
+STAGE_MAX_TOTAL_BYTES = 16 * 1024**2  # bytes of all files together
+STAGE_MAX_DEPTH = 8  # nested folders
 # Compiled code cannot be read by the forbidden-API scan: only source ships.
 STAGE_REFUSED_SUFFIXES = (".so", ".pyd", ".pyc", ".pyo", ".dylib", ".dll")
 STAGE_SKIPPED_NAMES = ("__pycache__", ".ipynb_checkpoints", ".DS_Store")

@@ -93,8 +93,6 @@ def scan_file(path):
     return scan_source(Path(path).read_text(encoding="utf-8", errors="replace"), path)
 
 
-
-
 def module_files(directory):
     """Every module of a package folder, by dotted name relative to the package.
 
@@ -173,12 +171,18 @@ def scan_package(directory, trusted_directory=None, overrides=None):
         own[name] = []
         for path in paths:
             trusted = Path(trusted_directory) / path.name if trusted_directory else None
-            pristine = (name in HELPER_MODULES and path.parent == Path(directory) and trusted is not None
-                        and trusted.exists() and trusted.read_bytes() == path.read_bytes())
+            pristine = (
+                name in HELPER_MODULES
+                and path.parent == Path(directory)
+                and trusted is not None
+                and trusted.exists()
+                and trusted.read_bytes() == path.read_bytes()
+            )
             if not pristine:
                 own[name].extend(scan_file(path))
-    graph = {name: {n for path in paths for n in _imported_names(path, name)} & set(files)
-             for name, paths in files.items()}
+    graph = {
+        name: {n for path in paths for n in _imported_names(path, name)} & set(files) for name, paths in files.items()
+    }
 
     def reachable(start):
         seen, stack = set(), [start, "__init__"]
@@ -189,5 +193,4 @@ def scan_package(directory, trusted_directory=None, overrides=None):
                 stack.extend(graph.get(name, ()))
         return seen
 
-    return {name: [v for module in sorted(reachable(name)) if module in own for v in own[module]]
-            for name in files}
+    return {name: [v for module in sorted(reachable(name)) if module in own for v in own[module]] for name in files}

@@ -55,8 +55,7 @@ class Implementation:
         module of a wrong submission against the reference for the rest).
     """
 
-    def __init__(self, directory, overrides=None, sandbox=False, call_timeout=config.CALL_TIMEOUT,
-                 sandbox_uid=None):
+    def __init__(self, directory, overrides=None, sandbox=False, call_timeout=config.CALL_TIMEOUT, sandbox_uid=None):
         self.directory = Path(directory).resolve() if not sandbox else Path(os.path.abspath(directory))
         self.overrides = {k: Path(v).resolve() for k, v in (overrides or {}).items()}
         self.package = f"_graded_impl_{next(_counter)}"

@@ -39,8 +39,12 @@ class _Renamer(ast.NodeTransformer):
 def _normalised(function):
     function = ast.parse(ast.unparse(function)).body[0]  # a copy
     body = function.body
-    if body and isinstance(body[0], ast.Expr) and isinstance(getattr(body[0], "value", None), ast.Constant) \
-            and isinstance(body[0].value.value, str):
+    if (
+        body
+        and isinstance(body[0], ast.Expr)
+        and isinstance(getattr(body[0], "value", None), ast.Constant)
+        and isinstance(body[0].value.value, str)
+    ):
         body = body[1:]
     if not body or all(isinstance(s, (ast.Pass, ast.Raise)) for s in body):
         return None  # stubs and empty functions say nothing
@@ -93,7 +97,7 @@ def reference_index(solutions=REPO_ROOT / "solutions"):
             fingerprints[fingerprint] = f"{path.name}:{name}"
         lines = _code_lines(source)
         for i in range(len(lines) - 2):
-            windows[" ".join(lines[i:i + 3])] = f"{path.name} ({lines[i][:50]})"
+            windows[" ".join(lines[i : i + 3])] = f"{path.name} ({lines[i][:50]})"
     return fingerprints, windows
 
 

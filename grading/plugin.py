@@ -29,11 +29,10 @@ from pathlib import Path
 
 import pytest
 
-from grading import config as grading_config
 from grading import GRADED_FUNCTIONS
+from grading import config as grading_config
 from grading.errors import CheckFailed, ForbiddenAPI, NotImplementedYet, SandboxError, StagingError
 from grading.implementation import Implementation
-
 
 _IMPL_KEY = pytest.StashKey[Implementation]()
 _RESULTS_KEY = pytest.StashKey[dict]()
@@ -41,28 +40,49 @@ _RESULTS_KEY = pytest.StashKey[dict]()
 
 def pytest_addoption(parser):
     group = parser.getgroup("grading", "course autograder")
-    group.addoption("--impl", default=None, metavar="DIR",
-                    help="folder of exercise modules to grade (default: ./pcl_course)")
-    group.addoption("--impl-module", action="append", default=[], metavar="MODULE=FILE",
-                    help="replace one exercise module of --impl by FILE")
-    group.addoption("--results", default=None, metavar="FILE",
-                    help="write the results (Gradescope JSON) to FILE")
-    group.addoption("--sandbox", action="store_true",
-                    help="run the implementation in a limited worker process (grading/sandbox.py)")
-    group.addoption("--call-timeout", type=float, default=grading_config.CALL_TIMEOUT, metavar="SECONDS",
-                    help=f"wall-clock limit of one call in the sandbox (default {grading_config.CALL_TIMEOUT:g})")
-    group.addoption("--sandbox-uid", type=int, default=None, metavar="UID",
-                    help="the dedicated uid that runs the submission when the grader is root")
-    group.addoption("--require-isolation", action="store_true",
-                    help="refuse to grade unless the submission runs isolated (bubblewrap or a dedicated uid)")
+    group.addoption(
+        "--impl", default=None, metavar="DIR", help="folder of exercise modules to grade (default: ./pcl_course)"
+    )
+    group.addoption(
+        "--impl-module",
+        action="append",
+        default=[],
+        metavar="MODULE=FILE",
+        help="replace one exercise module of --impl by FILE",
+    )
+    group.addoption("--results", default=None, metavar="FILE", help="write the results (Gradescope JSON) to FILE")
+    group.addoption(
+        "--sandbox", action="store_true", help="run the implementation in a limited worker process (grading/sandbox.py)"
+    )
+    group.addoption(
+        "--call-timeout",
+        type=float,
+        default=grading_config.CALL_TIMEOUT,
+        metavar="SECONDS",
+        help=f"wall-clock limit of one call in the sandbox (default {grading_config.CALL_TIMEOUT:g})",
+    )
+    group.addoption(
+        "--sandbox-uid",
+        type=int,
+        default=None,
+        metavar="UID",
+        help="the dedicated uid that runs the submission when the grader is root",
+    )
+    group.addoption(
+        "--require-isolation",
+        action="store_true",
+        help="refuse to grade unless the submission runs isolated (bubblewrap or a dedicated uid)",
+    )
 
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "points(n): marks that a graded test is worth")
     config.addinivalue_line("markers", "grades(function): the graded function a test grades")
     config.addinivalue_line("markers", "hidden: a graded test run by the instructors' grader only")
-    config.addinivalue_line("markers", "interface: a graded test of shapes, dtypes, errors or in-place "
-                                       "changes only (a degenerate answer may pass it)")
+    config.addinivalue_line(
+        "markers",
+        "interface: a graded test of shapes, dtypes, errors or in-place changes only (a degenerate answer may pass it)",
+    )
     config.stash[_RESULTS_KEY] = {}
 
 
@@ -76,13 +96,18 @@ def _implementation(config):
             if not sep:
                 raise pytest.UsageError(f"--impl-module takes MODULE=FILE, got {item!r}")
             overrides[module] = path
-        impl = Implementation(directory, overrides, sandbox=config.getoption("--sandbox"),
-                              call_timeout=config.getoption("--call-timeout"),
-                              sandbox_uid=config.getoption("--sandbox-uid"))
+        impl = Implementation(
+            directory,
+            overrides,
+            sandbox=config.getoption("--sandbox"),
+            call_timeout=config.getoption("--call-timeout"),
+            sandbox_uid=config.getoption("--sandbox-uid"),
+        )
         config.stash[_IMPL_KEY] = impl
         if impl.isolation is not None and not impl.isolation.isolated and config.getoption("--require-isolation"):
-            impl.refusal = SandboxError(f"refusing to grade: the submission could not be isolated "
-                                        f"({impl.isolation.reason})")
+            impl.refusal = SandboxError(
+                f"refusing to grade: the submission could not be isolated ({impl.isolation.reason})"
+            )
     return config.stash[_IMPL_KEY]
 
 
@@ -125,7 +150,8 @@ def pytest_collection_modifyitems(config, items):
     if unmarked:
         raise pytest.UsageError(
             "every graded test needs @pytest.mark.grades(<a function of grading.GRADED_FUNCTIONS>): "
-            + ", ".join(unmarked[:5]))
+            + ", ".join(unmarked[:5])
+        )
     for item in items:
         if _is_graded(item) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(grading_config.TEST_TIMEOUT))
@@ -186,7 +212,7 @@ def _feedback(excinfo, impl):
         cut = next((i for i, line in enumerate(lines) if line.startswith("assert ")), None)
         if cut:
             lines = lines[:cut]
-        lines = lines[:grading_config.MAX_FEEDBACK_LINES] or ["assertion failed"]
+        lines = lines[: grading_config.MAX_FEEDBACK_LINES] or ["assertion failed"]
         return "\n".join(lines) + last_call
     where = getattr(exc, "where", None) or (_location_in_implementation(excinfo, impl) if impl else None)
     where = f"\n  at {where}" if where else ""
@@ -201,15 +227,18 @@ def pytest_runtest_makereport(item, call):
         return
     report = outcome.get_result()
     results = item.config.stash[_RESULTS_KEY]
-    entry = results.setdefault(item.nodeid, {
-        "name": item.name,
-        "score": 0.0,
-        "max_score": _points(item),
-        "status": "failed",
-        "output": "",
-        "tags": [graded_function(item)],
-        "visibility": "after_published" if is_hidden(item) else "visible",
-    })
+    entry = results.setdefault(
+        item.nodeid,
+        {
+            "name": item.name,
+            "score": 0.0,
+            "max_score": _points(item),
+            "status": "failed",
+            "output": "",
+            "tags": [graded_function(item)],
+            "visibility": "after_published" if is_hidden(item) else "visible",
+        },
+    )
     if report.when == "call" and report.passed:
         entry.update(score=entry["max_score"], status="passed", output="")
     elif report.failed:
@@ -223,8 +252,9 @@ def pytest_runtest_makereport(item, call):
         if report.when != "call":
             message = f"error in test {report.when}: {message}"
         entry.update(score=0.0, status="failed", output=message)
-        if isinstance(call.excinfo.value if call.excinfo else None,
-                      (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError)):
+        if isinstance(
+            call.excinfo.value if call.excinfo else None, (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError)
+        ):
             report.longrepr = message  # one line, not a traceback
     elif report.skipped and report.when != "teardown":
         entry.update(score=0.0, status="failed", output="skipped")
@@ -270,7 +300,5 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
     if note:
         terminalreporter.write_line(note)
     for test in summary["tests"]:
-        terminalreporter.write_line(
-            f"{test['score']:5.1f} / {test['max_score']:<4.1f} {test['name']}"
-        )
+        terminalreporter.write_line(f"{test['score']:5.1f} / {test['max_score']:<4.1f} {test['name']}")
     terminalreporter.write_line(f"Total: {summary['score']:g} / {summary['max_score']:g}")

@@ -18,8 +18,18 @@ import yaml
 from grading import REPO_ROOT
 from grading.leakcheck import find_leaks
 
-COPIED = ["pcl_course", "grading", "tests/graded", "book", "scripts", "_toc.yml", "requirements.txt",
-          "requirements.in", ".gitignore", "benchmarks/results"]  # the appendix reads the results, not the harness
+COPIED = [
+    "pcl_course",
+    "grading",
+    "tests/graded",
+    "book",
+    "scripts",
+    "_toc.yml",
+    "requirements.txt",
+    "requirements.in",
+    ".gitignore",
+    "benchmarks/results",
+]  # the appendix reads the results, not the harness
 IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".ipynb_checkpoints")
 
 STUDENT_MAKEFILE = """\
@@ -104,8 +114,8 @@ def _student_config(text):
 
 def _student_pyproject(text):
     # The student package and the grader only: no reference, no benchmark harness.
-    text = re.sub(r'packages = \[[^\]]*\]', 'packages = ["pcl_course", "grading"]', text)
-    return re.sub(r'testpaths = \[[^\]]*\]', 'testpaths = ["tests/graded"]', text)
+    text = re.sub(r"packages = \[[^\]]*\]", 'packages = ["pcl_course", "grading"]', text)
+    return re.sub(r"testpaths = \[[^\]]*\]", 'testpaths = ["tests/graded"]', text)
 
 
 WORKFLOW_HEADER = """\
@@ -123,8 +133,20 @@ class _WorkflowDumper(yaml.SafeDumper):
 
 
 _WorkflowDumper.add_representer(
-    str, lambda dumper, text: dumper.represent_scalar("tag:yaml.org,2002:str", text,
-                                                      style="|" if "\n" in text else None))
+    str,
+    lambda dumper, text: dumper.represent_scalar("tag:yaml.org,2002:str", text, style="|" if "\n" in text else None),
+)
+
+
+SETUP_COMMANDS = [
+    "sudo apt-get update",
+    "sudo apt-get install -y --no-install-recommends libusb-1.0-0 bubblewrap",
+    "# Ubuntu 24.04 lets AppArmor forbid unprivileged user namespaces; bubblewrap needs them.",
+    "sudo sysctl -w kernel.apparmor_restrict_unprivileged_userns=0 || true",
+    "python -m pip install --quiet -r course/requirements.txt",
+    "python -m pip install --quiet --no-deps -e course",
+    "mkdir -p results",
+]
 
 
 def _student_workflow(course_repository):
@@ -135,52 +157,67 @@ def _student_workflow(course_repository):
     ``None`` reads it from the repository variable ``PCL_COURSE_REPOSITORY``.
     """
     repository = course_repository or "${{ vars.PCL_COURSE_REPOSITORY }}"
-    grade = " ".join([
-        "python -m grading grade ../submission --require-isolation --results ../results/results.json",
-        "| tee ../results/marks.txt",
-    ])
-    summary = "\n".join([
-        "{",
-        "  echo '## Advisory marks (public tests)'",
-        "  echo",
-        "  echo 'The official mark is the instructor'\\''s re-grade (or Gradescope).'",
-        "  echo",
-        "  echo '```'",
-        "  cat ../results/marks.txt",
-        "  echo '```'",
-        '} >> "$GITHUB_STEP_SUMMARY"',
-    ])
+    grade = " ".join(
+        [
+            "python -m grading grade ../submission --require-isolation --results ../results/results.json",
+            "| tee ../results/marks.txt",
+        ]
+    )
+    summary = "\n".join(
+        [
+            "{",
+            "  echo '## Advisory marks (public tests)'",
+            "  echo",
+            "  echo 'The official mark is the instructor'\\''s re-grade (or Gradescope).'",
+            "  echo",
+            "  echo '```'",
+            "  cat ../results/marks.txt",
+            "  echo '```'",
+            '} >> "$GITHUB_STEP_SUMMARY"',
+        ]
+    )
     workflow = {
         "name": "Advisory check",
         "on": {"push": None, "workflow_dispatch": None},
         "permissions": {"contents": "read"},
-        "jobs": {"check": {
-            "runs-on": "ubuntu-24.04",
-            "timeout-minutes": 30,
-            "steps": [
-                {"name": "Check out this repository (the submission)", "uses": "actions/checkout@v4",
-                 "with": {"path": "submission"}},
-                {"name": "Check out the pristine course (its grader and public tests)",
-                 "uses": "actions/checkout@v4",
-                 "with": {"repository": repository, "ref": "${{ vars.PCL_COURSE_REF || 'main' }}",
-                          "path": "course"}},
-                {"uses": "actions/setup-python@v5", "with": {"python-version": "3.11"}},
-                {"name": "Set up (Debian packages, pinned requirements, the sandbox)",
-                 "run": "\n".join([
-                     "sudo apt-get update",
-                     "sudo apt-get install -y --no-install-recommends libusb-1.0-0 bubblewrap",
-                     "# Ubuntu 24.04 lets AppArmor forbid unprivileged user namespaces; bubblewrap needs them.",
-                     "sudo sysctl -w kernel.apparmor_restrict_unprivileged_userns=0 || true",
-                     "python -m pip install --quiet -r course/requirements.txt",
-                     "python -m pip install --quiet --no-deps -e course",
-                     "mkdir -p results",
-                 ])},
-                {"name": "Grade with the pristine grader (advisory)", "working-directory": "course",
-                 "run": f"set -o pipefail\n{grade}"},
-                {"name": "Write the marks to the summary", "if": "always()", "working-directory": "course",
-                 "run": summary},
-            ],
-        }},
+        "jobs": {
+            "check": {
+                "runs-on": "ubuntu-24.04",
+                "timeout-minutes": 30,
+                "steps": [
+                    {
+                        "name": "Check out this repository (the submission)",
+                        "uses": "actions/checkout@v4",
+                        "with": {"path": "submission"},
+                    },
+                    {
+                        "name": "Check out the pristine course (its grader and public tests)",
+                        "uses": "actions/checkout@v4",
+                        "with": {
+                            "repository": repository,
+                            "ref": "${{ vars.PCL_COURSE_REF || 'main' }}",
+                            "path": "course",
+                        },
+                    },
+                    {"uses": "actions/setup-python@v5", "with": {"python-version": "3.11"}},
+                    {
+                        "name": "Set up (Debian packages, pinned requirements, the sandbox)",
+                        "run": "\n".join(SETUP_COMMANDS),
+                    },
+                    {
+                        "name": "Grade with the pristine grader (advisory)",
+                        "working-directory": "course",
+                        "run": f"set -o pipefail\n{grade}",
+                    },
+                    {
+                        "name": "Write the marks to the summary",
+                        "if": "always()",
+                        "working-directory": "course",
+                        "run": summary,
+                    },
+                ],
+            }
+        },
     }
     return WORKFLOW_HEADER + yaml.dump(workflow, Dumper=_WorkflowDumper, sort_keys=False, width=120)
 
@@ -205,14 +242,15 @@ def release(out_dir, course_repository=None):
     for page in (out / "book").glob("*.md"):
         page.write_text(_strip_solutions(page.read_text()))
     book_helper = out / "pcl_course" / "book.py"
-    book_helper.write_text(book_helper.read_text().replace(
-        'REFERENCE_PACKAGE = "solutions"', "REFERENCE_PACKAGE = None"))
+    book_helper.write_text(
+        book_helper.read_text().replace('REFERENCE_PACKAGE = "solutions"', "REFERENCE_PACKAGE = None")
+    )
     (out / "_config.yml").write_text(_student_config((REPO_ROOT / "_config.yml").read_text()))
     (out / "pyproject.toml").write_text(_student_pyproject((REPO_ROOT / "pyproject.toml").read_text()))
     (out / "Makefile").write_text(STUDENT_MAKEFILE)
     (out / "README.md").write_text(STUDENT_README)
     (out / ".ci").mkdir(exist_ok=True)
-    (out / ".ci" / "run").write_text("#!/usr/bin/env bash\nset -euo pipefail\ncd \"$(dirname \"$0\")/..\"\nmake test\n")
+    (out / ".ci" / "run").write_text('#!/usr/bin/env bash\nset -euo pipefail\ncd "$(dirname "$0")/.."\nmake test\n')
     workflow = out / ".github" / "workflows" / "check.yml"
     workflow.parent.mkdir(parents=True)
     workflow.write_text(_student_workflow(course_repository))

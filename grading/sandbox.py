@@ -55,7 +55,7 @@ import sys
 import tempfile
 import time
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
 import numpy as np
@@ -94,8 +94,10 @@ class Isolation:
             who = f"uid {self.uid}" if self.uid is not None else "the grader's user"
             return f"isolated: bubblewrap sandbox (no network, no files of the grader's), as {who}"
         if self.level == UID:
-            return (f"isolated by file permissions only: dedicated uid {self.uid}, no namespaces "
-                    f"({self.reason}); the network was reachable")
+            return (
+                f"isolated by file permissions only: dedicated uid {self.uid}, no namespaces "
+                f"({self.reason}); the network was reachable"
+            )
         return f"NOT ISOLATED ({self.reason}): this is a local check, not a mark"
 
 
@@ -131,9 +133,16 @@ def _make_reachable(path):
 
 def _site_dirs(root):
     """Folders under ``root`` that Python may import packages from."""
-    patterns = ("lib/python3*/site-packages", "lib/python3*/dist-packages", "lib/python3/dist-packages",
-                "local/lib/python3*/site-packages", "local/lib/python3*/dist-packages",
-                "python3*/site-packages", "python3*/dist-packages", "python3/dist-packages")
+    patterns = (
+        "lib/python3*/site-packages",
+        "lib/python3*/dist-packages",
+        "lib/python3/dist-packages",
+        "local/lib/python3*/site-packages",
+        "local/lib/python3*/dist-packages",
+        "python3*/site-packages",
+        "python3*/dist-packages",
+        "python3/dist-packages",
+    )
     found = {root} if root.name in ("site-packages", "dist-packages") else set()
     for pattern in patterns:
         found.update(p for p in root.glob(pattern) if p.is_dir())
@@ -151,8 +160,11 @@ def _masked_entries(site):
     masked = set()
     for entry in site.iterdir():
         stem = entry.name.split(".")[0].split("-")[0]
-        if stem in forbidden or entry.name.startswith(("__editable__", "pcl_course", "pcl-course")) \
-                or entry.name.endswith(".egg-link"):
+        if (
+            stem in forbidden
+            or entry.name.startswith(("__editable__", "pcl_course", "pcl-course"))
+            or entry.name.endswith(".egg-link")
+        ):
             masked.add(entry)
     for dist in importlib.metadata.distributions(path=[str(site)]):
         tops = {Path(str(f)).parts[0] for f in (dist.files or []) if not str(f).startswith("..")}
@@ -167,8 +179,19 @@ def _bubblewrap_command(staged_root, python_argv_tail):
     executable, relative = _python()
     base = Path(sys.base_prefix).resolve()
     site = _site_packages()
-    command = ["bwrap", "--unshare-all", "--unshare-user", "--disable-userns", "--die-with-parent",
-               "--new-session", "--clearenv", "--hostname", "sandbox", "--cap-drop", "ALL"]
+    command = [
+        "bwrap",
+        "--unshare-all",
+        "--unshare-user",
+        "--disable-userns",
+        "--die-with-parent",
+        "--new-session",
+        "--clearenv",
+        "--hostname",
+        "sandbox",
+        "--cap-drop",
+        "ALL",
+    ]
     system = [("/usr/lib", "/usr/lib"), ("/usr/lib64", "/usr/lib64"), ("/usr/lib32", "/usr/lib32")]
     for source, target in system:
         if Path(source).is_dir():
@@ -188,15 +211,28 @@ def _bubblewrap_command(staged_root, python_argv_tail):
                     command += ["--tmpfs", target]
                 else:
                     command += ["--ro-bind", "/dev/null", target]
-    command += ["--ro-bind", str(staged_root / "pcl_course"), f"{SANDBOX_SUBMISSION}/pcl_course",
-                "--ro-bind", str(staged_root / WORKER.name), SANDBOX_WORKER,
-                "--proc", "/proc", "--dev", "/dev",
-                "--size", str(config.TMP_SIZE), "--tmpfs", "/tmp", "--chdir", "/tmp"]
+    command += [
+        "--ro-bind",
+        str(staged_root / "pcl_course"),
+        f"{SANDBOX_SUBMISSION}/pcl_course",
+        "--ro-bind",
+        str(staged_root / WORKER.name),
+        SANDBOX_WORKER,
+        "--proc",
+        "/proc",
+        "--dev",
+        "/dev",
+        "--size",
+        str(config.TMP_SIZE),
+        "--tmpfs",
+        "/tmp",
+        "--chdir",
+        "/tmp",
+    ]
     for key, value in _environment("/tmp").items():
         command += ["--setenv", key, value]
     python = f"{SANDBOX_PYTHON_ROOT}/{relative}" if relative is not None else str(executable)
-    return [*command, "--", python, "-I", "-S", SANDBOX_WORKER, SANDBOX_SITE, SANDBOX_SUBMISSION,
-            *python_argv_tail]
+    return [*command, "--", python, "-I", "-S", SANDBOX_WORKER, SANDBOX_SITE, SANDBOX_SUBMISSION, *python_argv_tail]
 
 
 def _spawn(command, **kwargs):
@@ -218,18 +254,32 @@ def _spawn(command, **kwargs):
 
 
 def _environment(home):
-    return {"PATH": "/usr/bin:/bin", "HOME": home, "TMPDIR": home, "LANG": "C.UTF-8",
-            "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
-            "NUMBA_NUM_THREADS": "1", "NUMBA_CACHE_DIR": f"{home}/numba",
-            "OPEN3D_DISABLE_WEB_VISUALIZER": "true", "MPLBACKEND": "Agg"}
+    return {
+        "PATH": "/usr/bin:/bin",
+        "HOME": home,
+        "TMPDIR": home,
+        "LANG": "C.UTF-8",
+        "OMP_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "MKL_NUM_THREADS": "1",
+        "NUMBA_NUM_THREADS": "1",
+        "NUMBA_CACHE_DIR": f"{home}/numba",
+        "OPEN3D_DISABLE_WEB_VISUALIZER": "true",
+        "MPLBACKEND": "Agg",
+    }
 
 
 def _preexec(uid):
     """Run in the worker's process before exec: its own session, limits, the sandbox uid."""
+
     def apply():
         os.setsid()  # its own process group: killed as a whole, forks included
-        for limit, value in ((resource.RLIMIT_AS, config.MEMORY_LIMIT), (resource.RLIMIT_CPU, config.CPU_LIMIT),
-                             (resource.RLIMIT_FSIZE, config.FILE_SIZE_LIMIT), (resource.RLIMIT_CORE, 0)):
+        for limit, value in (
+            (resource.RLIMIT_AS, config.MEMORY_LIMIT),
+            (resource.RLIMIT_CPU, config.CPU_LIMIT),
+            (resource.RLIMIT_FSIZE, config.FILE_SIZE_LIMIT),
+            (resource.RLIMIT_CORE, 0),
+        ):
             try:
                 resource.setrlimit(limit, (value, value))
             except (OSError, ValueError):
@@ -242,6 +292,7 @@ def _preexec(uid):
             os.setuid(uid)
         if uid is not None or os.geteuid() != 0:
             resource.setrlimit(resource.RLIMIT_NPROC, (config.PROCESS_LIMIT, config.PROCESS_LIMIT))
+
     return apply
 
 
@@ -298,18 +349,20 @@ def kill_uid(uid):
 
 
 def _probe_script(paths):
-    return ("import os, sys\n"
-            f"sys.path.append({str(_site_packages())!r})\n"
-            "import numpy\n"
-            "readable = []\n"
-            f"for path in {[str(p) for p in paths]!r}:\n"
-            "    try:\n"
-            "        os.listdir(path) if os.path.isdir(path) else open(path).close()\n"
-            "        readable.append(path)\n"
-            "    except OSError:\n"
-            "        pass\n"
-            "import json\n"
-            "print(json.dumps(readable))\n")
+    return (
+        "import os, sys\n"
+        f"sys.path.append({str(_site_packages())!r})\n"
+        "import numpy\n"
+        "readable = []\n"
+        f"for path in {[str(p) for p in paths]!r}:\n"
+        "    try:\n"
+        "        os.listdir(path) if os.path.isdir(path) else open(path).close()\n"
+        "        readable.append(path)\n"
+        "    except OSError:\n"
+        "        pass\n"
+        "import json\n"
+        "print(json.dumps(readable))\n"
+    )
 
 
 _HELD_UIDS = {}  # uid -> the open lock file that reserves it for this process
@@ -359,8 +412,14 @@ def _bubblewrap_works(uid):
         (staged / "pcl_course").mkdir(mode=0o755)
         (staged / WORKER.name).write_text("import sys\nsys.path.append(sys.argv[1])\nimport numpy\n")
         (staged / WORKER.name).chmod(0o644)
-        probe = _spawn(_bubblewrap_command(staged, []), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                       text=True, preexec_fn=_preexec(uid), env={})
+        probe = _spawn(
+            _bubblewrap_command(staged, []),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            preexec_fn=_preexec(uid),
+            env={},
+        )
         _, stderr = probe.communicate(timeout=60)
         if probe.returncode == 0:
             return None
@@ -380,9 +439,15 @@ def permission_wall(uid, protected):
     mode bits.
     """
     try:
-        completed = subprocess.run([str(_python()[0]), "-I", "-S", "-c", _probe_script(protected)],
-                                   capture_output=True, text=True, timeout=60, preexec_fn=_preexec(uid), env={},
-                                   cwd="/")
+        completed = subprocess.run(
+            [str(_python()[0]), "-I", "-S", "-c", _probe_script(protected)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            preexec_fn=_preexec(uid),
+            env={},
+            cwd="/",
+        )
     except (OSError, subprocess.SubprocessError) as exc:
         return f"uid {uid} cannot run Python: {exc}"
     finally:
@@ -392,12 +457,14 @@ def permission_wall(uid, protected):
     lines = [line for line in completed.stdout.splitlines() if line.startswith("[")]
     readable = json.loads(lines[-1]) if lines else ["?"]
     if readable:
-        return (f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
-                f"(chmod 700) and keep the Python environment outside it")
+        return (
+            f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
+            f"(chmod 700) and keep the Python environment outside it"
+        )
     return None
 
 
-@lru_cache(maxsize=None)
+@cache
 def isolation(uid=None):
     """The strongest isolation available here for the sandbox ``uid``.
 
@@ -472,8 +539,15 @@ class Worker:
         tail = [",".join(config.FORBIDDEN_PACKAGES)]
         if self.isolation.level == BUBBLEWRAP:
             return _bubblewrap_command(self.staged_root, tail), {}
-        python = [str(_python()[0]), "-I", "-S", str(self.staged_root / WORKER.name), str(_site_packages()),
-                  str(self.staged_root), *tail]
+        python = [
+            str(_python()[0]),
+            "-I",
+            "-S",
+            str(self.staged_root / WORKER.name),
+            str(_site_packages()),
+            str(self.staged_root),
+            *tail,
+        ]
         return python, _environment(self.work)
 
     def start(self):
@@ -490,9 +564,15 @@ class Worker:
             os.chown(self.work, self.uid, self.uid)
         command, env = self._command()
         self.stderr = tempfile.TemporaryFile()
-        self.process = _spawn(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                        stderr=self.stderr, env=env, cwd=self.work,
-                                        preexec_fn=_preexec(self.uid))
+        self.process = _spawn(
+            command,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.stderr,
+            env=env,
+            cwd=self.work,
+            preexec_fn=_preexec(self.uid),
+        )
         self.buffer = b""
         try:
             header = self._read_frame(time.monotonic() + max(self.timeout, 60.0))
@@ -580,8 +660,9 @@ class Worker:
     def _call(self, module, function, args, kwargs):
         arguments = {"args": list(args), "kwargs": dict(kwargs)}
         read_only = [path for path, value in _arrays(arguments, []) if not value.flags.writeable]
-        request = pickle.dumps({"module": module, "function": function, "args": args, "kwargs": kwargs,
-                                "read_only": read_only})
+        request = pickle.dumps(
+            {"module": module, "function": function, "args": args, "kwargs": kwargs, "read_only": read_only}
+        )
         deadline = time.monotonic() + self.timeout
         try:
             self.process.stdin.write(struct.pack("<Q", len(request)) + request)
@@ -591,16 +672,22 @@ class Worker:
         try:
             header = self._read_frame(deadline)
         except SandboxError as exc:
-            self.broken[module] = (f"{module}.py cannot be imported: {exc}; every test of {module}.py "
-                                   "fails until its import is fixed")
+            self.broken[module] = (
+                f"{module}.py cannot be imported: {exc}; every test of {module}.py fails until its import is fixed"
+            )
             raise SandboxError(self.broken[module]) from None
         if not header.get("imported"):
             failure = _exception(header) if header.get("phase") == "import" and "type" in header else None
-            what = f"raised {header.get('type')}: {header.get('message')}" if failure is not None else \
-                "the worker's answer was garbled"
+            what = (
+                f"raised {header.get('type')}: {header.get('message')}"
+                if failure is not None
+                else "the worker's answer was garbled"
+            )
             where = f" (at {header['where']})" if isinstance(header.get("where"), str) and header["where"] else ""
-            self.broken[module] = (f"{module}.py cannot be imported: it {what}{where}; every test of "
-                                   f"{module}.py fails until its import is fixed")
+            self.broken[module] = (
+                f"{module}.py cannot be imported: it {what}{where}; every test of "
+                f"{module}.py fails until its import is fixed"
+            )
             raise SandboxError(self.broken[module])
         answer = self._read_frame(deadline)
         arrays = {}
@@ -684,8 +771,12 @@ def _write_back(arguments, modified, arrays):
                 target.bit_generator.state = change["state"]
             elif type(target) is np.ndarray:
                 value = _decode(change["value"], arrays)
-                if type(value) is np.ndarray and value.shape == target.shape and value.dtype == target.dtype \
-                        and target.flags.writeable:
+                if (
+                    type(value) is np.ndarray
+                    and value.shape == target.shape
+                    and value.dtype == target.dtype
+                    and target.flags.writeable
+                ):
                     target[...] = value
         except (KeyError, IndexError, TypeError, ValueError):
             raise SandboxError("the worker's answer was garbled") from None
@@ -726,8 +817,9 @@ def _decode(node, arrays):
         elif kind == "dict":
             return {str(key): _decode(value, arrays) for key, value in node["items"].items()}
         elif kind == "unsupported":
-            raise SandboxError(f"returned {node.get('what')}: return plain numpy arrays, numbers, strings, "
-                               "tuples, lists or dicts")
+            raise SandboxError(
+                f"returned {node.get('what')}: return plain numpy arrays, numbers, strings, tuples, lists or dicts"
+            )
     except (KeyError, TypeError, ValueError, AttributeError):
         pass
     raise SandboxError("the worker's answer was garbled")

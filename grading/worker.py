@@ -40,8 +40,10 @@ class _ForbiddenImports:
 
     def find_spec(self, name, path=None, target=None):
         if name.split(".")[0] in self.packages:
-            raise ImportError(f"{name} is not available to submissions: write your own code "
-                              "(Open3D, PCL and scikit-learn are for visualisation only)")
+            raise ImportError(
+                f"{name} is not available to submissions: write your own code "
+                "(Open3D, PCL and scikit-learn are for visualisation only)"
+            )
         return None
 
 
@@ -89,8 +91,11 @@ def _snapshot(value, np):
 def _changed(value, before, np):
     if isinstance(value, np.random.Generator):
         return value.bit_generator.state != before
-    return (value.shape != before.shape or value.dtype != before.dtype
-            or not np.array_equal(value, before, equal_nan=value.dtype.kind in "fc"))
+    return (
+        value.shape != before.shape
+        or value.dtype != before.dtype
+        or not np.array_equal(value, before, equal_nan=value.dtype.kind in "fc")
+    )
 
 
 def _where(exc):
@@ -102,8 +107,13 @@ def _where(exc):
 
 
 def _failure(exc):
-    return {"ok": False, "type": type(exc).__name__, "builtin": type(exc).__module__ == "builtins",
-            "message": str(exc)[:2000], "where": _where(exc)}
+    return {
+        "ok": False,
+        "type": type(exc).__name__,
+        "builtin": type(exc).__module__ == "builtins",
+        "message": str(exc)[:2000],
+        "where": _where(exc),
+    }
 
 
 class _Protocol:

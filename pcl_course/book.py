@@ -36,8 +36,10 @@ def _show_stubs_briefly():
         return
 
     def not_implemented(shell, etype, value, tb, tb_offset=None):
-        print(f"Not implemented yet: {value}. Implement it in pcl_course/, then rebuild the book "
-              "to see this cell's results.")
+        print(
+            f"Not implemented yet: {value}. Implement it in pcl_course/, then rebuild the book "
+            "to see this cell's results."
+        )
         return []
 
     shell.set_custom_exc((NotImplementedError,), not_implemented)

@@ -40,12 +40,24 @@ __all__ = [
 ]
 
 SHAPE_NAMES = (
-    "sphere", "box", "cylinder", "cone", "torus", "plane", "ellipsoid",
-    "chair", "table", "lamp", "airplane", "mug", "bottle",
+    "sphere",
+    "box",
+    "cylinder",
+    "cone",
+    "torus",
+    "plane",
+    "ellipsoid",
+    "chair",
+    "table",
+    "lamp",
+    "airplane",
+    "mug",
+    "bottle",
 )
 
 
 # --- primitives: uniform surface samples in a local frame -----------------
+
 
 def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
@@ -204,10 +216,8 @@ def _box(size, center=(0.0, 0.0, 0.0)):
     for sign in (1.0, -1.0):
         up = None if sign > 0 else _FLIP
         faces.append(_Part("rectangle", ((sx, sy),), up, (cx, cy, cz + sign * sz / 2)))
-        faces.append(_Part("rectangle", ((sz, sy),), _rotation("y", sign * np.pi / 2),
-                           (cx + sign * sx / 2, cy, cz)))
-        faces.append(_Part("rectangle", ((sx, sz),), _rotation("x", -sign * np.pi / 2),
-                           (cx, cy + sign * sy / 2, cz)))
+        faces.append(_Part("rectangle", ((sz, sy),), _rotation("y", sign * np.pi / 2), (cx + sign * sx / 2, cy, cz)))
+        faces.append(_Part("rectangle", ((sx, sz),), _rotation("x", -sign * np.pi / 2), (cx, cy + sign * sy / 2, cz)))
     return faces
 
 
@@ -263,8 +273,9 @@ def _shape_parts(name, jitter):
         parts = _box((length, width, t), (0.0, 0.0, height - t / 2))
         for sx in (-1, 1):
             for sy in (-1, 1):
-                parts += _cylinder(r, height - t, base=(sx * (length / 2 - 0.08), sy * (width / 2 - 0.08), 0.0),
-                                   top=False)
+                parts += _cylinder(
+                    r, height - t, base=(sx * (length / 2 - 0.08), sy * (width / 2 - 0.08), 0.0), top=False
+                )
         return parts
     if name == "lamp":
         pole = j(0.8)
@@ -297,8 +308,10 @@ def _shape_parts(name, jitter):
 def _cone(j, height):
     radius = j(0.5)
     base = -height / 2
-    return [_Part("frustum", (radius, 0.0, height), None, (0.0, 0.0, base)),
-            _Part("disk", (radius,), _FLIP, (0.0, 0.0, base))]
+    return [
+        _Part("frustum", (radius, 0.0, height), None, (0.0, 0.0, base)),
+        _Part("disk", (radius,), _FLIP, (0.0, 0.0, base)),
+    ]
 
 
 def make_shape(name, n_points=2048, noise=0.0, rng=None, variation=0.0):
@@ -368,6 +381,7 @@ def normalize_unit_sphere(points):
 
 
 # --- mini ModelNet ---------------------------------------------------------
+
 
 def make_mini_modelnet(root, n_per_class=4, n_test_per_class=1, n_points=2048, seed=0, classes=SHAPE_NAMES):
     """Write a small ModelNet40 look-alike to ``root``.
@@ -444,8 +458,7 @@ LIDAR_CLASSES = ("ground", "building", "car", "pole", "vegetation", "pedestrian"
 """Class names of :attr:`LidarScan.labels` (spurious returns have label -1)."""
 
 # Diffuse reflectivity per class, for the simulated intensity.
-_REFLECTIVITY = {"ground": 0.25, "building": 0.45, "car": 0.7, "pole": 0.55,
-                 "vegetation": 0.35, "pedestrian": 0.3}
+_REFLECTIVITY = {"ground": 0.25, "building": 0.45, "car": 0.7, "pole": 0.55, "vegetation": 0.35, "pedestrian": 0.3}
 
 SENSOR_HEIGHT = 1.73  # metres above the ground, as on the KITTI car
 
@@ -512,8 +525,14 @@ def make_street_scene(seed=0, half_length=100.0):
 
     extent = 1.2 * half_length
     ground = o3d.geometry.TriangleMesh(
-        o3d.utility.Vector3dVector([[-extent, -extent, ground_z], [extent, -extent, ground_z],
-                                    [extent, extent, ground_z], [-extent, extent, ground_z]]),
+        o3d.utility.Vector3dVector(
+            [
+                [-extent, -extent, ground_z],
+                [extent, -extent, ground_z],
+                [extent, extent, ground_z],
+                [-extent, extent, ground_z],
+            ]
+        ),
         o3d.utility.Vector3iVector([[0, 1, 2], [0, 2, 3]]),
     )
     meshes.append((ground, "ground"))
@@ -525,14 +544,16 @@ def make_street_scene(seed=0, half_length=100.0):
             height = rng.uniform(6.0, 22.0)
             depth = 10.0
             setback = rng.uniform(9.0, 12.0)
-            box((length, depth, height), (x + length / 2, side * (setback + depth / 2), ground_z + height / 2),
-                "building")
+            box(
+                (length, depth, height),
+                (x + length / 2, side * (setback + depth / 2), ground_z + height / 2),
+                "building",
+            )
             x += length + rng.uniform(1.0, 8.0)
         x = -half_length + rng.uniform(0.0, 6.0)
         while x < half_length:  # parked cars
             if rng.uniform() < 0.7:
-                box((rng.uniform(3.8, 4.8), 1.8, rng.uniform(1.4, 1.7)),
-                    (x, side * 5.2, ground_z + 0.75), "car")
+                box((rng.uniform(3.8, 4.8), 1.8, rng.uniform(1.4, 1.7)), (x, side * 5.2, ground_z + 0.75), "car")
             x += rng.uniform(5.5, 9.0)
         for x in np.arange(-half_length + 10.0, half_length, 22.0) + rng.uniform(-2, 2):
             cylinder(0.12, 7.0, (x, side * 7.0, ground_z), "pole")
@@ -542,16 +563,21 @@ def make_street_scene(seed=0, half_length=100.0):
             crown.translate([x, side * 7.5, ground_z + 4.0])
             meshes.append((crown, "vegetation"))
         for _ in range(4):
-            cylinder(0.25, rng.uniform(1.6, 1.9), (rng.uniform(-40, 40), side * rng.uniform(6.2, 8.0), ground_z),
-                     "pedestrian")
+            cylinder(
+                0.25,
+                rng.uniform(1.6, 1.9),
+                (rng.uniform(-40, 40), side * rng.uniform(6.2, 8.0), ground_z),
+                "pedestrian",
+            )
     for x in rng.uniform(-60.0, 60.0, 5):  # cars driving in the lanes
         if abs(x) > 6.0:
             box((4.5, 1.8, 1.5), (x, rng.choice([-1.8, 1.8]), ground_z + 0.75), "car")
     return meshes
 
 
-def simulate_lidar_scan(seed=0, n_beams=64, n_azimuth=1800, max_range=100.0,
-                        range_noise=0.02, outlier_fraction=0.005, fov=(2.0, -24.8)):
+def simulate_lidar_scan(
+    seed=0, n_beams=64, n_azimuth=1800, max_range=100.0, range_noise=0.02, outlier_fraction=0.005, fov=(2.0, -24.8)
+):
     """Scan the street with a simulated 64-beam spinning lidar.
 
     The beams are spread evenly over the vertical field of view ``fov``

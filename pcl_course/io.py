@@ -15,8 +15,12 @@ import numpy as np
 from pcl_course.validation import as_array, as_points
 
 __all__ = [
-    "read_modelnet_txt", "write_modelnet_txt", "read_kitti_bin", "write_kitti_bin",
-    "read_kitti_depth_png", "write_kitti_depth_png",
+    "read_modelnet_txt",
+    "write_modelnet_txt",
+    "read_kitti_bin",
+    "write_kitti_bin",
+    "read_kitti_depth_png",
+    "write_kitti_depth_png",
 ]
 
 

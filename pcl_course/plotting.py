@@ -52,8 +52,7 @@ def plot_cloud(ax, points, color=None, size=2.0, cmap="viridis", axis_labels=Tru
         kwargs["color"] = color
     else:
         kwargs.update(c=color, cmap=cmap)
-    artist = ax.scatter(points[:, 0], points[:, 1], points[:, 2], s=size,
-                        linewidths=0, depthshade=False, **kwargs)
+    artist = ax.scatter(points[:, 0], points[:, 1], points[:, 2], s=size, linewidths=0, depthshade=False, **kwargs)
     set_axes_equal(ax, points)
     if axis_labels:
         ax.set_xlabel("x")
@@ -66,15 +65,24 @@ def plot_vectors(ax, origins, vectors, length=1.0, color="k", **kwargs):
     """Draw arrows (normals, principal axes) from ``origins`` along ``vectors``."""
     origins = np.atleast_2d(origins)
     vectors = np.atleast_2d(vectors) * length
-    return ax.quiver(origins[:, 0], origins[:, 1], origins[:, 2],
-                     vectors[:, 0], vectors[:, 1], vectors[:, 2],
-                     color=color, arrow_length_ratio=0.15, **kwargs)
+    return ax.quiver(
+        origins[:, 0],
+        origins[:, 1],
+        origins[:, 2],
+        vectors[:, 0],
+        vectors[:, 1],
+        vectors[:, 2],
+        color=color,
+        arrow_length_ratio=0.15,
+        **kwargs,
+    )
 
 
 # --- interactive figures (Plotly) -------------------------------------------
 #
 # The book loads one local copy of plotly.js on the pages that need it (see
 # book/_ext/offline_assets.py), so figures are written without it.
+
 
 def cloud_trace(points, color=None, size=1.5, name=None, colorscale="Viridis", showscale=False, **marker):
     """A Plotly 3-D scatter trace of a cloud, coloured by height by default."""
@@ -83,7 +91,11 @@ def cloud_trace(points, color=None, size=1.5, name=None, colorscale="Viridis", s
     points = np.asarray(points, dtype=float)
     color = points[:, 2] if color is None else color
     return go.Scatter3d(
-        x=points[:, 0], y=points[:, 1], z=points[:, 2], mode="markers", name=name,
+        x=points[:, 0],
+        y=points[:, 1],
+        z=points[:, 2],
+        mode="markers",
+        name=name,
         marker=dict(size=size, color=color, colorscale=colorscale, showscale=showscale, **marker),
         hoverinfo="skip",
     )
@@ -97,8 +109,15 @@ def vectors_trace(origins, vectors, length=1.0, color="black", name=None, width=
     ends = origins + np.atleast_2d(vectors) * length
     segments = np.full((3 * len(origins), 3), np.nan)  # NaN rows break the line between segments
     segments[0::3], segments[1::3] = origins, ends
-    return go.Scatter3d(x=segments[:, 0], y=segments[:, 1], z=segments[:, 2], mode="lines", name=name,
-                        line=dict(color=color, width=width), hoverinfo="skip")
+    return go.Scatter3d(
+        x=segments[:, 0],
+        y=segments[:, 1],
+        z=segments[:, 2],
+        mode="lines",
+        name=name,
+        line=dict(color=color, width=width),
+        hoverinfo="skip",
+    )
 
 
 def interactive_figure(traces, title=None, height=520, camera_eye=(1.4, -1.4, 0.9)):
@@ -107,7 +126,9 @@ def interactive_figure(traces, title=None, height=520, camera_eye=(1.4, -1.4, 0.
 
     figure = go.Figure(data=list(traces))
     figure.update_layout(
-        title=title, height=height, margin=dict(l=0, r=0, t=40 if title else 10, b=0),
+        title=title,
+        height=height,
+        margin=dict(l=0, r=0, t=40 if title else 10, b=0),
         scene=dict(aspectmode="data", camera=dict(eye=dict(zip("xyz", camera_eye)))),
         legend=dict(itemsizing="constant"),
     )
@@ -118,5 +139,6 @@ def show_interactive(figure):
     """Display a Plotly figure in the book: an HTML fragment without plotly.js."""
     from IPython.display import HTML
 
-    return HTML(figure.to_html(full_html=False, include_plotlyjs=False,
-                               config={"displaylogo": False, "responsive": True}))
+    return HTML(
+        figure.to_html(full_html=False, include_plotlyjs=False, config={"displaylogo": False, "responsive": True})
+    )

@@ -54,9 +54,7 @@ def as_array(values, name, ndim=None, dtype=np.float64, allow_empty=True):
         allowed = (ndim,) if isinstance(ndim, int) else tuple(ndim)
         if array.ndim not in allowed:
             expected = " or ".join(str(d) for d in allowed)
-            raise ValueError(
-                f"{name} must have {expected} dimension(s), got shape {array.shape}"
-            )
+            raise ValueError(f"{name} must have {expected} dimension(s), got shape {array.shape}")
     if not allow_empty and array.size == 0:
         raise ValueError(f"{name} must not be empty, got shape {array.shape}")
     if not np.all(np.isfinite(array)):
@@ -95,9 +93,7 @@ def as_points(points, name="points", min_columns=3, columns=None, allow_empty=Tr
     if columns is not None and width != columns:
         raise ValueError(f"{name} must have shape (N, {columns}), got {array.shape}")
     if columns is None and width < min_columns:
-        raise ValueError(
-            f"{name} must have at least {min_columns} columns, got shape {array.shape}"
-        )
+        raise ValueError(f"{name} must have at least {min_columns} columns, got shape {array.shape}")
     if not allow_empty and array.shape[0] == 0:
         raise ValueError(f"{name} must hold at least one point, got shape {array.shape}")
     return array
@@ -139,6 +135,4 @@ def check_rng(rng, name="rng"):
         return np.random.default_rng(rng)
     if isinstance(rng, numbers.Integral) and not isinstance(rng, bool) and rng >= 0:
         return np.random.default_rng(int(rng))
-    raise ValueError(
-        f"{name} must be None, a non-negative int seed or a numpy Generator, got {rng!r}"
-    )
+    raise ValueError(f"{name} must be None, a non-negative int seed or a numpy Generator, got {rng!r}")

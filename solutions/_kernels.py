@@ -86,6 +86,7 @@ def hash_groups(keys):
             slot = (slot + 1) & mask
     return groups, uniques[:m]
 
+
 @njit(cache=True)
 def reservoir_choice(groups, n_groups, uniform):
     """One uniformly random member of every group, in one pass (reservoir sampling).
@@ -219,8 +220,8 @@ def bucket_fps(x, y, z, ids, n_samples, start, bucket_size):
     return selected
 
 
-
 # --- normals --------------------------------------------------------------------
+
 
 @njit(cache=True, inline="always")
 def _eigenvector(a00, a01, a02, a11, a12, a22, value):
@@ -269,8 +270,16 @@ def _second_eigenvector(a00, a01, a02, a11, a12, a22, w, value):
         inv = 1.0 / np.sqrt(w[1] * w[1] + w[2] * w[2])
         u = (0.0, w[2] * inv, -w[1] * inv)
     v = (w[1] * u[2] - w[2] * u[1], w[2] * u[0] - w[0] * u[2], w[0] * u[1] - w[1] * u[0])
-    au = (a00 * u[0] + a01 * u[1] + a02 * u[2], a01 * u[0] + a11 * u[1] + a12 * u[2], a02 * u[0] + a12 * u[1] + a22 * u[2])
-    av = (a00 * v[0] + a01 * v[1] + a02 * v[2], a01 * v[0] + a11 * v[1] + a12 * v[2], a02 * v[0] + a12 * v[1] + a22 * v[2])
+    au = (
+        a00 * u[0] + a01 * u[1] + a02 * u[2],
+        a01 * u[0] + a11 * u[1] + a12 * u[2],
+        a02 * u[0] + a12 * u[1] + a22 * u[2],
+    )
+    av = (
+        a00 * v[0] + a01 * v[1] + a02 * v[2],
+        a01 * v[0] + a11 * v[1] + a12 * v[2],
+        a02 * v[0] + a12 * v[1] + a22 * v[2],
+    )
     m00 = u[0] * au[0] + u[1] * au[1] + u[2] * au[2] - value
     m01 = u[0] * av[0] + u[1] * av[1] + u[2] * av[2]
     m11 = v[0] * av[0] + v[1] * av[1] + v[2] * av[2] - value
@@ -329,8 +338,12 @@ def smallest_eigenpair(a00, a01, a02, a11, a12, a22):
     # The trigonometric root loses half the digits at a double root (a line:
     # two eigenvalues zero); the Rayleigh quotient of the accurate vector
     # does not.
-    rayleigh = (a00 * n[0] * n[0] + a11 * n[1] * n[1] + a22 * n[2] * n[2]
-                + 2.0 * (a01 * n[0] * n[1] + a02 * n[0] * n[2] + a12 * n[1] * n[2]))
+    rayleigh = (
+        a00 * n[0] * n[0]
+        + a11 * n[1] * n[1]
+        + a22 * n[2] * n[2]
+        + 2.0 * (a01 * n[0] * n[1] + a02 * n[0] * n[2] + a12 * n[1] * n[2])
+    )
     return rayleigh * scale, n[0], n[1], n[2]
 
 
@@ -378,5 +391,6 @@ def normals_from_neighbourhoods(points, members, offsets):
     for i in range(n):
         if offsets[i + 1] - offsets[i] >= 3:
             normals[i, 0], normals[i, 1], normals[i, 2], curvature[i] = patch_normal(
-                points, members, offsets[i], offsets[i + 1])
+                points, members, offsets[i], offsets[i + 1]
+            )
     return normals, curvature

@@ -173,8 +173,11 @@ def morton_order(xyz):
     lower, upper = axis_bounds(xyz)
     span = float((upper - lower).max()) or 1.0
     cells = np.minimum((xyz - lower) * ((2**21 - 1) / span), 2**21 - 1).astype(np.uint64)
-    code = _spread_bits(cells[:, 0]) | (_spread_bits(cells[:, 1]) << np.uint64(1)) | (
-        _spread_bits(cells[:, 2]) << np.uint64(2))
+    code = (
+        _spread_bits(cells[:, 0])
+        | (_spread_bits(cells[:, 1]) << np.uint64(1))
+        | (_spread_bits(cells[:, 2]) << np.uint64(2))
+    )
     return np.argsort(code, kind="stable")
 
 
@@ -290,8 +293,26 @@ LISTS, MEAN_DISTANCE, NORMAL = 0, 1, 2
 
 
 @njit(cache=True, nogil=True)
-def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, right, lower, upper, mode,
-                leaf_from, leaf_to, out_d, out_i, out_normal, out_value):
+def _knn_leaves(
+    points,
+    leaf_size,
+    k,
+    skip_self,
+    window,
+    first,
+    last,
+    left,
+    right,
+    lower,
+    upper,
+    mode,
+    leaf_from,
+    leaf_to,
+    out_d,
+    out_i,
+    out_normal,
+    out_value,
+):
     """k nearest neighbours of the points of leaves ``leaf_from..leaf_to-1``, a leaf at a time.
 
     Phase 1 offers each query the rows around its leaf (k on either side):
@@ -402,7 +423,8 @@ def _knn_leaves(points, leaf_size, k, skip_self, window, first, last, left, righ
                 out_value[q] = total / k
             else:
                 out_normal[q, 0], out_normal[q, 1], out_normal[q, 2], out_value[q] = patch_normal(
-                    points, best_i[a], 0, k)
+                    points, best_i[a], 0, k
+                )
 
 
 def _run_leaves(xyz, k, skip_self, mode, leaf_size=LEAF_SIZE, window=None):

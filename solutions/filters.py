@@ -6,8 +6,8 @@ import numbers
 import numpy as np
 from scipy.spatial import cKDTree
 
-from solutions._neighbors import grid_is_usable, grid_radius_count, kdtree, knn_mean_distance
 from pcl_course.validation import as_array, as_points, check_integer, check_positive
+from solutions._neighbors import grid_is_usable, grid_radius_count, kdtree, knn_mean_distance
 
 
 def radius_outlier_removal(points, radius, min_neighbors):

@@ -129,13 +129,9 @@ def kernel_pca_transform(new_points, points, alphas, kernel="gaussian", beta=1.0
     points = as_points(points, min_columns=1, allow_empty=False)
     alphas = as_array(alphas, "alphas", ndim=2)
     if alphas.shape[0] != points.shape[0]:
-        raise ValueError(
-            f"alphas must have one row per training point ({points.shape[0]}), got {alphas.shape}"
-        )
+        raise ValueError(f"alphas must have one row per training point ({points.shape[0]}), got {alphas.shape}")
     if new_points.shape[1] != points.shape[1]:
-        raise ValueError(
-            f"new_points must have the width of points ({points.shape[1]}), got {new_points.shape}"
-        )
+        raise ValueError(f"new_points must have the width of points ({points.shape[1]}), got {new_points.shape}")
     gram = kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
     new_rows = kernel_matrix(new_points, points, kernel=kernel, beta=beta, degree=degree)
     column_means, grand_mean = _centring_terms(gram)

@@ -27,7 +27,8 @@ def _page_context(app, pagename, templatename, context, doctree):
     scripts = context.get("script_files", [])
     # In place: the list is the builder's, where add_js_file below appends.
     scripts[:] = [
-        script for script in scripts
+        script
+        for script in scripts
         if "thebe" not in str(getattr(script, "filename", script) or "")
         and "THEBE_JS_URL" not in str(getattr(script, "attributes", {}).get("body", ""))
     ]

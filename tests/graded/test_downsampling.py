@@ -38,6 +38,7 @@ def cloud():
 
 # --- voxel_grid_downsample ------------------------------------------------------
 
+
 @pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(1)
 @pytest.mark.interface
@@ -55,28 +56,38 @@ def test_voxel_grid_downsample_centroids_in_linear_index_order(impl, cloud):
         f"expected {len(expected)} occupied voxels, got {len(result)} rows; "
         "hint: origin at the per-axis minimum, h = floor((p - min) / voxel_size)"
     )
-    check_close(result, expected, "centroids", rtol=1e-9, atol=1e-12,
-                hint="one row per voxel, the mean of ALL columns, ordered by linear index (x fastest, then y, z)")
+    check_close(
+        result,
+        expected,
+        "centroids",
+        rtol=1e-9,
+        atol=1e-12,
+        hint="one row per voxel, the mean of ALL columns, ordered by linear index (x fastest, then y, z)",
+    )
 
 
 @pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(2)
 def test_voxel_grid_downsample_hand_built_voxels(impl):
     # Voxel size 1, minimum at (0.5, 0.5, 0.5): the origin is the minimum, not 0.
-    points = np.array([
-        [0.5, 0.5, 0.5, 10.0],   # h = (0, 0, 0), linear index 0
-        [1.4, 0.6, 0.7, 20.0],   # h = (0, 0, 0)
-        [1.6, 0.5, 0.5, 30.0],   # h = (1, 0, 0), index 1
-        [0.5, 1.6, 0.5, 40.0],   # h = (0, 1, 0), index D_x = 3
-        [2.6, 2.6, 2.6, 50.0],   # h = (2, 2, 2), the maximum
-    ])
+    points = np.array(
+        [
+            [0.5, 0.5, 0.5, 10.0],  # h = (0, 0, 0), linear index 0
+            [1.4, 0.6, 0.7, 20.0],  # h = (0, 0, 0)
+            [1.6, 0.5, 0.5, 30.0],  # h = (1, 0, 0), index 1
+            [0.5, 1.6, 0.5, 40.0],  # h = (0, 1, 0), index D_x = 3
+            [2.6, 2.6, 2.6, 50.0],  # h = (2, 2, 2), the maximum
+        ]
+    )
     result = impl.voxel_grid_downsample(points, 1.0)
-    expected = np.array([
-        [0.95, 0.55, 0.6, 15.0],
-        [1.6, 0.5, 0.5, 30.0],
-        [0.5, 1.6, 0.5, 40.0],
-        [2.6, 2.6, 2.6, 50.0],
-    ])
+    expected = np.array(
+        [
+            [0.95, 0.55, 0.6, 15.0],
+            [1.6, 0.5, 0.5, 30.0],
+            [0.5, 1.6, 0.5, 40.0],
+            [2.6, 2.6, 2.6, 50.0],
+        ]
+    )
     check_close(result, expected, "downsampled", hint="origin at the per-axis MINIMUM of the points")
 
 
@@ -88,8 +99,7 @@ def test_voxel_grid_downsample_when_the_extent_is_a_multiple_of_the_size(impl):
     points = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.5, 0.0], [1.0, 0.0, 0.0]])
     result = impl.voxel_grid_downsample(points, 1.0)
     expected = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.5, 0.0]])
-    check_close(result, expected, "downsampled",
-                hint="grid size per axis D = floor((max - min) / voxel_size) + 1")
+    check_close(result, expected, "downsampled", hint="grid size per axis D = floor((max - min) / voxel_size) + 1")
 
 
 @pytest.mark.grades("voxel_grid_downsample")
@@ -99,8 +109,12 @@ def test_voxel_grid_downsample_on_a_grid_too_large_for_int64(impl):
     # 2^64, which wraps to 0 in int64 and would merge it with the first.
     points = np.array([[0.0, 0.0, 0.0], [65535.0, 65535.0, 0.0], [0.0, 0.0, 2.0**32], [1.0, 0.0, 2.0**32]])
     result = impl.voxel_grid_downsample(points[[2, 0, 3, 1]], 1.0)  # the output is in voxel order
-    check_close(result, points, "downsampled",
-                hint="4 distinct voxels; the linear index overflows int64 here: sort by (h_z, h_y, h_x) instead")
+    check_close(
+        result,
+        points,
+        "downsampled",
+        hint="4 distinct voxels; the linear index overflows int64 here: sort by (h_z, h_y, h_x) instead",
+    )
 
 
 @pytest.mark.grades("voxel_grid_downsample")
@@ -113,16 +127,23 @@ def test_voxel_grid_downsample_on_a_lidar_sized_grid(impl):
     result = impl.voxel_grid_downsample(xyz, 0.05)
     expected = expected_centroids(xyz, 0.05)
     assert result.shape == expected.shape, f"expected {len(expected)} voxels, got {len(result)}"
-    check_close(result, expected, "centroids", rtol=1e-12, atol=1e-9,
-                hint="int32 linear indices overflow on this grid (6.4e9 voxels)")
+    check_close(
+        result,
+        expected,
+        "centroids",
+        rtol=1e-12,
+        atol=1e-9,
+        hint="int32 linear indices overflow on this grid (6.4e9 voxels)",
+    )
 
 
 @pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.points(3)
 def test_voxel_grid_downsample_random_picks_every_row_uniformly(impl):
     # One voxel of 4 rows: over 400 seeds each row must be picked about 100 times.
-    points = np.array([[0.1, 0.1, 0.1, 0.0], [0.2, 0.3, 0.1, 1.0], [0.4, 0.2, 0.3, 2.0], [0.3, 0.4, 0.2, 3.0],
-                       [5.0, 5.0, 5.0, 4.0]])
+    points = np.array(
+        [[0.1, 0.1, 0.1, 0.0], [0.2, 0.3, 0.1, 1.0], [0.4, 0.2, 0.3, 2.0], [0.3, 0.4, 0.2, 3.0], [5.0, 5.0, 5.0, 4.0]]
+    )
     picks = []
     for seed in range(400):
         result = impl.voxel_grid_downsample(points, 1.0, method="random", rng=seed)
@@ -155,10 +176,16 @@ def test_voxel_grid_downsample_empty_cloud(impl):
 
 
 @pytest.mark.points(0.5)
-@pytest.mark.parametrize("kwargs, name", [
-    ({"voxel_size": 0.0}, "voxel_size"), ({"voxel_size": -1.0}, "voxel_size"),
-    ({"method": "median"}, "method"), ({"points": np.zeros((4, 2))}, "points"),
-], ids=["size-zero", "size-negative", "method", "width"])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"voxel_size": 0.0}, "voxel_size"),
+        ({"voxel_size": -1.0}, "voxel_size"),
+        ({"method": "median"}, "method"),
+        ({"points": np.zeros((4, 2))}, "points"),
+    ],
+    ids=["size-zero", "size-negative", "method", "width"],
+)
 @pytest.mark.grades("voxel_grid_downsample")
 @pytest.mark.interface
 def test_voxel_grid_downsample_rejects_bad_input(impl, kwargs, name):
@@ -169,6 +196,7 @@ def test_voxel_grid_downsample_rejects_bad_input(impl, kwargs, name):
 
 
 # --- approximate_voxel_downsample ---------------------------------------------------
+
 
 @pytest.mark.grades("approximate_voxel_downsample")
 @pytest.mark.points(2)
@@ -184,25 +212,33 @@ def test_approximate_voxel_downsample_without_conflicts_is_the_exact_filter(impl
 def test_approximate_voxel_downsample_hand_built_conflicts(impl):
     # Voxel size 1, D = (4, 2, 1); 3 containers. Linear index -> container:
     # (0,0,0) -> 0 -> 0; (3,0,0) -> 3 -> 0; (1,0,0) -> 1 -> 1; (1,1,0) -> 5 -> 2
-    points = np.array([
-        [0.1, 0.1, 0.0],   # voxel 0, container 0 (empty): held
-        [0.3, 0.2, 0.0],   # voxel 0, container 0: same voxel, held
-        [3.5, 0.5, 0.0],   # voxel 3, container 0: CONFLICT -> emit centroid of voxel 0
-        [1.5, 0.5, 0.0],   # voxel 1, container 1: held
-        [1.5, 1.5, 0.0],   # voxel 5, container 2: held
-        [0.4, 0.9, 0.0],   # voxel 0, container 0: CONFLICT -> emit voxel 3
-        [1.7, 0.1, 0.0],   # voxel 1, container 1: held
-    ])
+    points = np.array(
+        [
+            [0.1, 0.1, 0.0],  # voxel 0, container 0 (empty): held
+            [0.3, 0.2, 0.0],  # voxel 0, container 0: same voxel, held
+            [3.5, 0.5, 0.0],  # voxel 3, container 0: CONFLICT -> emit centroid of voxel 0
+            [1.5, 0.5, 0.0],  # voxel 1, container 1: held
+            [1.5, 1.5, 0.0],  # voxel 5, container 2: held
+            [0.4, 0.9, 0.0],  # voxel 0, container 0: CONFLICT -> emit voxel 3
+            [1.7, 0.1, 0.0],  # voxel 1, container 1: held
+        ]
+    )
     result = impl.approximate_voxel_downsample(points, 1.0, n_containers=3)
-    expected = np.array([
-        [0.2, 0.15, 0.0],    # emitted by the first conflict
-        [3.5, 0.5, 0.0],     # emitted by the second conflict
-        [0.4, 0.9, 0.0],     # end: container 0
-        [1.6, 0.3, 0.0],     # end: container 1
-        [1.5, 1.5, 0.0],     # end: container 2
-    ])
-    check_close(result, expected, "emitted rows",
-                hint="on a conflict emit the container's voxel first; at the end emit containers in increasing order")
+    expected = np.array(
+        [
+            [0.2, 0.15, 0.0],  # emitted by the first conflict
+            [3.5, 0.5, 0.0],  # emitted by the second conflict
+            [0.4, 0.9, 0.0],  # end: container 0
+            [1.6, 0.3, 0.0],  # end: container 1
+            [1.5, 1.5, 0.0],  # end: container 2
+        ]
+    )
+    check_close(
+        result,
+        expected,
+        "emitted rows",
+        hint="on a conflict emit the container's voxel first; at the end emit containers in increasing order",
+    )
 
 
 @pytest.mark.grades("approximate_voxel_downsample")
@@ -216,8 +252,13 @@ def test_approximate_voxel_downsample_with_one_container(impl):
     keys = voxel_keys(points, 1.0)
     change = np.flatnonzero(np.any(keys[1:] != keys[:-1], axis=1)) + 1
     runs = np.split(points, change)
-    check_close(result, np.array([run.mean(axis=0) for run in runs]), "one-container output", rtol=1e-9,
-                hint="with one container, each run of consecutive points in one voxel gives one row")
+    check_close(
+        result,
+        np.array([run.mean(axis=0) for run in runs]),
+        "one-container output",
+        rtol=1e-9,
+        hint="with one container, each run of consecutive points in one voxel gives one row",
+    )
 
 
 @pytest.mark.grades("approximate_voxel_downsample")
@@ -229,8 +270,9 @@ def test_approximate_voxel_downsample_hash_uses_all_three_axes(impl):
     points = np.array([[0.0, 0.0, 0.0], [0.5, 1.5, 1.5], [1.5, 0.2, 0.1], [0.2, 0.1, 0.0], [0.3, 1.7, 1.1]])
     result = impl.approximate_voxel_downsample(points, 1.0, n_containers=7)
     expected = np.array([[0.1, 0.05, 0.0], [1.5, 0.2, 0.1], [0.4, 1.6, 1.3]])
-    check_close(result, expected, "emitted rows",
-                hint="linear index h_x + h_y * D_x + h_z * D_x * D_y, then % n_containers")
+    check_close(
+        result, expected, "emitted rows", hint="linear index h_x + h_y * D_x + h_z * D_x * D_y, then % n_containers"
+    )
 
 
 @pytest.mark.grades("approximate_voxel_downsample")
@@ -253,8 +295,11 @@ def test_approximate_voxel_downsample_random_returns_rows_of_the_container(impl)
 @pytest.mark.interface
 def test_approximate_voxel_downsample_rejects_bad_input(impl):
     points = np.random.default_rng(35).uniform(size=(10, 3))
-    for kwargs, name in (({"n_containers": 0}, "n_containers"), ({"voxel_size": 0.0}, "voxel_size"),
-                         ({"method": "mode"}, "method")):
+    for kwargs, name in (
+        ({"n_containers": 0}, "n_containers"),
+        ({"voxel_size": 0.0}, "voxel_size"),
+        ({"method": "mode"}, "method"),
+    ):
         arguments = {"points": points, "voxel_size": 0.5, "n_containers": 10, **kwargs}
         with pytest.raises(ValueError) as excinfo:
             impl.approximate_voxel_downsample(**arguments)
@@ -262,6 +307,7 @@ def test_approximate_voxel_downsample_rejects_bad_input(impl):
 
 
 # --- farthest_point_sampling -------------------------------------------------------------
+
 
 @pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(1)
@@ -295,8 +341,7 @@ def test_farthest_point_sampling_uses_the_nearest_selected_point(impl):
     points = np.array([[0.0, 0, 0], [10.0, 0, 0], [0.5, 0, 0], [5.0, 4.0, 0]])
     result = impl.farthest_point_sampling(points, 3)
     assert result.tolist() == [0, 1, 3], (
-        f"expected [0, 1, 3], got {result.tolist()}: the distance to the NEAREST selected point, "
-        "not to the last one"
+        f"expected [0, 1, 3], got {result.tolist()}: the distance to the NEAREST selected point, not to the last one"
     )
 
 
@@ -360,9 +405,13 @@ def test_farthest_point_sampling_extremes_and_errors(impl, cloud):
     every = impl.farthest_point_sampling(cloud, len(cloud), start_index=7)
     check_array(every, "indices", shape=(len(cloud),), dtype="int64")
     assert every[0] == 7 and np.array_equal(np.sort(every), np.arange(len(cloud))), (
-        "n_samples = N selects every point once, starting at start_index")
-    for kwargs, name in (({"n_samples": 3001}, "n_samples"), ({"n_samples": -1}, "n_samples"),
-                         ({"start_index": 3000}, "start_index")):
+        "n_samples = N selects every point once, starting at start_index"
+    )
+    for kwargs, name in (
+        ({"n_samples": 3001}, "n_samples"),
+        ({"n_samples": -1}, "n_samples"),
+        ({"start_index": 3000}, "start_index"),
+    ):
         arguments = {"points": cloud, "n_samples": 5, **kwargs}
         with pytest.raises(ValueError) as excinfo:
             impl.farthest_point_sampling(**arguments)
@@ -370,6 +419,7 @@ def test_farthest_point_sampling_extremes_and_errors(impl, cloud):
 
 
 # --- normal_space_sampling ------------------------------------------------------------------
+
 
 def bucket(normals, n_bins):
     b = np.clip(np.floor((normals + 1.0) / 2.0 * n_bins), 0, n_bins - 1).astype(int)
@@ -452,8 +502,11 @@ def test_normal_space_sampling_bucket_boundaries(impl):
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_normal_space_sampling_rejects_bad_input(impl, skewed_normals):
-    for kwargs, name in (({"n_samples": 1001}, "n_samples"), ({"n_bins": 0}, "n_bins"),
-                         ({"normals": np.zeros((5, 2))}, "normals")):
+    for kwargs, name in (
+        ({"n_samples": 1001}, "n_samples"),
+        ({"n_bins": 0}, "n_bins"),
+        ({"normals": np.zeros((5, 2))}, "normals"),
+    ):
         arguments = {"normals": skewed_normals, "n_samples": 10, **kwargs}
         with pytest.raises(ValueError) as excinfo:
             impl.normal_space_sampling(**arguments)

@@ -14,8 +14,8 @@ from scipy.spatial.distance import cdist
 
 from grading.checks import check_array, check_close
 
-
 # --- radius_outlier_removal ------------------------------------------------------
+
 
 @pytest.mark.grades("radius_outlier_removal")
 @pytest.mark.points(2)
@@ -55,6 +55,7 @@ def test_radius_outlier_removal_empty_and_errors(impl):
 
 
 # --- statistical_outlier_removal ----------------------------------------------------
+
 
 def mean_distances(points, k):
     """Mean distance to the k nearest OTHER points (by index), brute force."""
@@ -151,6 +152,7 @@ def test_statistical_outlier_removal_rejects_bad_k(impl):
 
 # --- bilateral_filter_image ---------------------------------------------------------
 
+
 def bilateral_pixel(image, y, x, sigma_s, sigma_r, r):
     """The filter's formula at one pixel, with plain loops over its window."""
     num = den = 0.0
@@ -182,20 +184,29 @@ def test_bilateral_filter_image_matches_its_formula(impl):
 def test_bilateral_filter_image_default_radius(impl):
     image = np.random.default_rng(56).uniform(0, 1, size=(8, 8))
     result = impl.bilateral_filter_image(image, 0.7, 0.5)  # r = ceil(1.4) = 2
-    check_close(result[3, 4], bilateral_pixel(image, 3, 4, 0.7, 0.5, 2), "pixel (3, 4) with radius=None",
-                hint="radius=None means r = ceil(2 * sigma_s)")
+    check_close(
+        result[3, 4],
+        bilateral_pixel(image, 3, 4, 0.7, 0.5, 2),
+        "pixel (3, 4) with radius=None",
+        hint="radius=None means r = ceil(2 * sigma_s)",
+    )
 
 
 @pytest.mark.grades("bilateral_filter_image")
 @pytest.mark.points(2)
 def test_bilateral_filter_image_leaves_a_constant_image_unchanged(impl):
     image = np.full((7, 9), 5.0)
-    check_close(impl.bilateral_filter_image(image, 2.0, 10.0), image, "filtered constant image",
-                hint="pixels outside the image do not count (no zero padding)")
+    check_close(
+        impl.bilateral_filter_image(image, 2.0, 10.0),
+        image,
+        "filtered constant image",
+        hint="pixels outside the image do not count (no zero padding)",
+    )
     noisy = image + np.random.default_rng(60).normal(scale=0.1, size=image.shape)
     smoothed = impl.bilateral_filter_image(noisy, 2.0, 10.0)
     assert np.abs(smoothed - 5.0).max() < 0.5 * np.abs(noisy - 5.0).max(), (
-        "with sigma_r = 10 the filter is a Gaussian blur: noise on a constant image must shrink")
+        "with sigma_r = 10 the filter is a Gaussian blur: noise on a constant image must shrink"
+    )
 
 
 @pytest.mark.grades("bilateral_filter_image")
@@ -211,10 +222,12 @@ def test_bilateral_filter_image_keeps_a_step_edge(impl):
     noisy = image + np.random.default_rng(61).normal(scale=0.01, size=image.shape)
     result = impl.bilateral_filter_image(noisy, 2.0, 0.1)
     assert np.abs(result - image).max() < 0.05 and (result - image).std() < 0.8 * (noisy - image).std(), (
-        "a noisy step with sigma_r = 0.1: the edge must survive and the noise on each side must shrink")
+        "a noisy step with sigma_r = 0.1: the edge must survive and the noise on each side must shrink"
+    )
 
 
 # --- bilateral_filter_points ------------------------------------------------------------
+
 
 @pytest.mark.grades("bilateral_filter_points")
 @pytest.mark.points(2)
@@ -224,13 +237,19 @@ def test_bilateral_filter_points_leaves_a_plane_on_its_plane(impl):
     normals = np.tile([0.0, 0.0, 1.0], (300, 1))
     result = impl.bilateral_filter_points(points, normals, 0.3, 0.2, 0.1)
     check_array(result, "filtered", shape=(300, 3))
-    check_close(result, points, "filtered plane", atol=1e-12,
-                hint="on a plane every h = n_p . (q - p) is 0: points must not move")
+    check_close(
+        result,
+        points,
+        "filtered plane",
+        atol=1e-12,
+        hint="on a plane every h = n_p . (q - p) is 0: points must not move",
+    )
     lifted = points.copy()
     lifted[0, 2] += 0.05
     result = impl.bilateral_filter_points(lifted, normals, 0.3, 0.2, 0.1)
     assert abs(result[0, 2] - 2.0) < 0.04, (
-        f"a point 0.05 above the plane must be pulled towards it, got height {result[0, 2] - 2.0:.4f}")
+        f"a point 0.05 above the plane must be pulled towards it, got height {result[0, 2] - 2.0:.4f}"
+    )
 
 
 @pytest.mark.grades("bilateral_filter_points")
@@ -246,10 +265,14 @@ def test_bilateral_filter_points_matches_its_formula(impl):
         near = d[i] <= 0.25
         offsets = points[near] - points[i]
         h = offsets @ normals[i]
-        w = np.exp(-d[i, near] ** 2 / (2 * 0.15**2)) * np.exp(-(h**2) / (2 * 0.04**2))
+        w = np.exp(-(d[i, near] ** 2) / (2 * 0.15**2)) * np.exp(-(h**2) / (2 * 0.04**2))
         expected = points[i] + normals[i] * np.sum(w * h) / np.sum(w)
-        check_close(result[i], expected, f"point {i}",
-                    hint="p' = p + n_p * sum(w h) / sum(w), over ||q - p|| <= radius, p included")
+        check_close(
+            result[i],
+            expected,
+            f"point {i}",
+            hint="p' = p + n_p * sum(w h) / sum(w), over ||q - p|| <= radius, p included",
+        )
 
 
 @pytest.mark.grades("bilateral_filter_points")
@@ -269,6 +292,7 @@ def test_bilateral_filter_points_moves_only_along_the_normal(impl):
 
 
 # --- joint_bilateral_upsample ----------------------------------------------------------
+
 
 @pytest.mark.grades("joint_bilateral_upsample")
 @pytest.mark.points(2)

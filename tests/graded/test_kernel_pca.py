@@ -57,6 +57,7 @@ def blob():
 
 # --- kernel_matrix ---------------------------------------------------------
 
+
 @pytest.mark.grades("kernel_matrix")
 @pytest.mark.points(2)
 @pytest.mark.parametrize("kernel", ["linear", "polynomial", "gaussian", "laplacian"])
@@ -74,8 +75,10 @@ def test_kernel_matrix_closed_forms(impl, kernel):
     }[kernel]
     result = impl.kernel_matrix(x, y, kernel=kernel, beta=beta, degree=degree)
     check_array(result, "K", shape=(3, 2))
-    hint = {"gaussian": "gaussian: exp(-beta * ||x - y||_2 ** 2), with the square",
-            "laplacian": "laplacian: exp(-beta * ||x - y||_1), the L1 norm"}.get(kernel, "")
+    hint = {
+        "gaussian": "gaussian: exp(-beta * ||x - y||_2 ** 2), with the square",
+        "laplacian": "laplacian: exp(-beta * ||x - y||_1), the L1 norm",
+    }.get(kernel, "")
     check_close(result, expected, f"kernel_matrix(kernel={kernel!r})", hint=hint)
 
 
@@ -93,6 +96,7 @@ def test_kernel_matrix_rejects_unknown_kernel_and_bad_beta(impl):
 
 
 # --- kernel_pca -------------------------------------------------------------
+
 
 @pytest.mark.grades("kernel_pca")
 @pytest.mark.points(1)
@@ -112,8 +116,13 @@ def test_kernel_pca_returns_arrays_of_the_right_shapes(impl, blob):
 def test_kernel_pca_eigenvalues_match_sklearn(impl, blob, kernel):
     expected = SklearnKPCA(blob, 4, kernel, beta=0.8).eigenvalues
     _, eigenvalues, _ = impl.kernel_pca(blob, 4, kernel=kernel, beta=0.8)
-    check_close(eigenvalues, expected, "eigenvalues", rtol=1e-6,
-                hint="eigenvalues of K~ = K - 1_N K - K 1_N + 1_N K 1_N, not divided by N, descending")
+    check_close(
+        eigenvalues,
+        expected,
+        "eigenvalues",
+        rtol=1e-6,
+        hint="eigenvalues of K~ = K - 1_N K - K 1_N + 1_N K 1_N, not divided by N, descending",
+    )
 
 
 @pytest.mark.grades("kernel_pca")
@@ -122,8 +131,14 @@ def test_kernel_pca_eigenvalues_match_sklearn(impl, blob, kernel):
 def test_kernel_pca_projections_match_sklearn(impl, blob, kernel):
     expected = SklearnKPCA(blob, 3, kernel, beta=0.8).projections
     projections, _, _ = impl.kernel_pca(blob, 3, kernel=kernel, beta=0.8)
-    check_close(align_signs(projections, expected), expected, "projections (up to sign)", rtol=1e-5, atol=1e-8,
-                hint="projections = K~ @ alphas with ||alphas[:, r]||^2 = 1 / eigenvalues[r]")
+    check_close(
+        align_signs(projections, expected),
+        expected,
+        "projections (up to sign)",
+        rtol=1e-5,
+        atol=1e-8,
+        hint="projections = K~ @ alphas with ||alphas[:, r]||^2 = 1 / eigenvalues[r]",
+    )
 
 
 @pytest.mark.grades("kernel_pca")
@@ -132,14 +147,24 @@ def test_kernel_pca_alphas_are_scaled_eigenvectors(impl, blob):
     projections, eigenvalues, alphas = impl.kernel_pca(blob, 3, kernel="gaussian", beta=0.5)
     check_finite(eigenvalues, "eigenvalues")
     check_finite(alphas, "alphas")
-    check_close(np.sum(alphas**2, axis=0), 1.0 / eigenvalues, "||alphas[:, r]||^2",
-                rtol=1e-6, hint="scale each unit eigenvector by 1 / sqrt(eigenvalue)")
+    check_close(
+        np.sum(alphas**2, axis=0),
+        1.0 / eigenvalues,
+        "||alphas[:, r]||^2",
+        rtol=1e-6,
+        hint="scale each unit eigenvector by 1 / sqrt(eigenvalue)",
+    )
     k = np.exp(-0.5 * np.sum((blob[:, None] - blob[None]) ** 2, axis=2))
     n = len(blob)
     one = np.full((n, n), 1.0 / n)
     centred = k - one @ k - k @ one + one @ k @ one
-    check_close(centred @ alphas, alphas * eigenvalues, "K~ @ alphas[:, r] vs eigenvalues[r] * alphas[:, r]",
-                rtol=1e-6, atol=1e-9)
+    check_close(
+        centred @ alphas,
+        alphas * eigenvalues,
+        "K~ @ alphas[:, r] vs eigenvalues[r] * alphas[:, r]",
+        rtol=1e-6,
+        atol=1e-9,
+    )
     check_close(projections, centred @ alphas, "projections vs K~ @ alphas", rtol=1e-6, atol=1e-9)
 
 
@@ -152,11 +177,22 @@ def test_kernel_pca_with_the_linear_kernel_is_linear_pca(impl):
     centred = points - points.mean(axis=0)
     values, vectors = np.linalg.eigh(centred.T @ centred / len(points))
     values, vectors = values[::-1], vectors[:, ::-1]
-    check_close(eigenvalues, len(points) * values[:2], "eigenvalues (linear kernel)", rtol=1e-6,
-                hint="the centred Gram matrix's eigenvalues are N times the covariance's")
+    check_close(
+        eigenvalues,
+        len(points) * values[:2],
+        "eigenvalues (linear kernel)",
+        rtol=1e-6,
+        hint="the centred Gram matrix's eigenvalues are N times the covariance's",
+    )
     expected = centred @ vectors[:, :2]
-    check_close(align_signs(projections, expected), expected, "projections (linear kernel)", rtol=1e-6, atol=1e-8,
-                hint="with the linear kernel the projections are the linear-PCA coordinates")
+    check_close(
+        align_signs(projections, expected),
+        expected,
+        "projections (linear kernel)",
+        rtol=1e-6,
+        atol=1e-8,
+        hint="with the linear kernel the projections are the linear-PCA coordinates",
+    )
 
 
 @pytest.mark.grades("kernel_pca")
@@ -170,6 +206,7 @@ def test_kernel_pca_rejects_bad_n_components(impl, blob):
 
 
 # --- kernel_pca_transform ----------------------------------------------------
+
 
 @pytest.mark.grades("kernel_pca_transform")
 @pytest.mark.points(2)
@@ -191,8 +228,14 @@ def test_kernel_pca_transform_of_new_points_matches_sklearn(impl, blob, kernel):
     signs = np.sign(np.sum(projections * model.projections, axis=0))
     result = impl.kernel_pca_transform(new_points, blob, alphas, kernel=kernel, beta=0.8)
     check_array(result, "projections", shape=(7, 3))
-    check_close(result * signs, model.transform(new_points), "projections of new points", rtol=1e-5, atol=1e-8,
-                hint="centre the new kernel rows with THEIR row means and the TRAINING K's column and grand means")
+    check_close(
+        result * signs,
+        model.transform(new_points),
+        "projections of new points",
+        rtol=1e-5,
+        atol=1e-8,
+        hint="centre the new kernel rows with THEIR row means and the TRAINING K's column and grand means",
+    )
 
 
 @pytest.mark.grades("kernel_pca_transform")
@@ -206,6 +249,11 @@ def test_kernel_pca_transform_of_one_new_point_with_the_linear_kernel(impl):
     centred = points - points.mean(axis=0)
     vectors = np.linalg.eigh(centred.T @ centred)[1][:, ::-1][:, :2]
     signs = np.sign(np.sum(projections * (centred @ vectors), axis=0))
-    check_close(result * signs, (new_point - points.mean(axis=0)) @ vectors,
-                "projection of a new point (linear kernel)", rtol=1e-6, atol=1e-9,
-                hint="a new point is centred with the TRAINING mean: x - m, projected on the principal axes")
+    check_close(
+        result * signs,
+        (new_point - points.mean(axis=0)) @ vectors,
+        "projection of a new point (linear kernel)",
+        rtol=1e-6,
+        atol=1e-9,
+        hint="a new point is centred with the TRAINING mean: x - m, projected on the principal axes",
+    )

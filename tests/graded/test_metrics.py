@@ -38,7 +38,8 @@ def test_chamfer_distance_of_identical_sets_is_zero(impl):
     # ... and only those: a unit grid moved by 0.1 is 0.1^2 away in both directions.
     grid = np.stack(np.meshgrid(*[np.arange(4.0)] * 3), axis=-1).reshape(-1, 3)
     assert impl.chamfer_distance(grid, grid + [0.1, 0.0, 0.0]) == pytest.approx(0.02, rel=1e-9), (
-        "a unit grid and its copy moved by 0.1 along x: 0.01 + 0.01 = 0.02")
+        "a unit grid and its copy moved by 0.1 along x: 0.01 + 0.01 = 0.02"
+    )
 
 
 @pytest.mark.grades("chamfer_distance")
@@ -56,15 +57,19 @@ def test_chamfer_distance_rejects_bad_input(impl):
 @pytest.mark.grades("depth_metrics")
 @pytest.mark.points(2)
 def test_depth_metrics_hand_computed(impl):
-    gt = np.array([[2.0, 0.0], [4.0, 5.0]])       # metres; 0 = no ground truth
+    gt = np.array([[2.0, 0.0], [4.0, 5.0]])  # metres; 0 = no ground truth
     pred = np.array([[2.5, 9.0], [4.0, 4.0]])
     # Errors at the valid pixels: 0.5, 0, -1 m; inverse errors -0.1, 0, 0.05 1/m.
     result = impl.depth_metrics(pred, gt)
     assert isinstance(result, dict) and set(result) >= {"rmse", "mae", "irmse", "imae"}, (
         "depth_metrics must return a dict with keys rmse, mae, irmse, imae"
     )
-    expected = {"rmse": 1000 * np.sqrt(1.25 / 3), "mae": 500.0,
-                "irmse": np.sqrt((100.0**2 + 50.0**2) / 3), "imae": 50.0}
+    expected = {
+        "rmse": 1000 * np.sqrt(1.25 / 3),
+        "mae": 500.0,
+        "irmse": np.sqrt((100.0**2 + 50.0**2) / 3),
+        "imae": 50.0,
+    }
     for key, value in expected.items():
         assert np.isclose(result[key], value, rtol=1e-9), (
             f"{key}: expected {value:.4f}, got {result[key]!r}; units: rmse and mae in millimetres, "
@@ -82,4 +87,5 @@ def test_depth_metrics_of_a_perfect_prediction(impl):
     # ... and a prediction 1 m too far everywhere is 1000 mm off on every valid pixel.
     off = impl.depth_metrics(np.where(gt > 0, gt + 1.0, 7.0), gt)
     assert abs(off["rmse"] - 1000.0) < 1e-6 and abs(off["mae"] - 1000.0) < 1e-6, (
-        f"a prediction 1 m too far must give rmse = mae = 1000 mm, got {off}")
+        f"a prediction 1 m too far must give rmse = mae = 1000 mm, got {off}"
+    )

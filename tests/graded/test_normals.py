@@ -37,6 +37,7 @@ def sphere_points(n, rng, radius=2.0, centre=(0.0, 0.0, 0.0)):
 
 # --- fit_plane -----------------------------------------------------------
 
+
 @pytest.mark.grades("fit_plane")
 @pytest.mark.points(2)
 def test_fit_plane_recovers_a_known_plane(impl):
@@ -78,8 +79,12 @@ def test_fit_plane_uses_the_weights(impl):
     points = np.vstack([on_plane, off_plane])
     weights = np.concatenate([rng.uniform(0.5, 2.0, 50), np.zeros(10)])
     centroid, result = impl.fit_plane(points, weights)
-    check_close(centroid, weights @ points / weights.sum(), "weighted centroid",
-                hint="the centroid is the WEIGHTED mean sum(w x) / sum(w)")
+    check_close(
+        centroid,
+        weights @ points / weights.sum(),
+        "weighted centroid",
+        hint="the centroid is the WEIGHTED mean sum(w x) / sum(w)",
+    )
     assert abs_cos(result, normal) > 1 - 1e-9, "points of weight 0 must not move the plane"
     # scaling all weights changes nothing
     centroid2, result2 = impl.fit_plane(points, weights * 7.5)
@@ -88,9 +93,14 @@ def test_fit_plane_uses_the_weights(impl):
 
 
 @pytest.mark.points(1)
-@pytest.mark.parametrize("weights", [
-    "negative", "zero-sum", "wrong-length",
-])
+@pytest.mark.parametrize(
+    "weights",
+    [
+        "negative",
+        "zero-sum",
+        "wrong-length",
+    ],
+)
 @pytest.mark.grades("fit_plane")
 @pytest.mark.interface
 def test_fit_plane_rejects_bad_weights(impl, weights):
@@ -102,6 +112,7 @@ def test_fit_plane_rejects_bad_weights(impl, weights):
 
 
 # --- estimate_normals ------------------------------------------------------
+
 
 @pytest.mark.grades("estimate_normals")
 @pytest.mark.points(1)
@@ -130,8 +141,9 @@ def test_estimate_normals_of_a_whole_cloud_neighbourhood(impl):
         f"normal {normals[0].round(4)} is not the least-variance direction {vectors[:, 0].round(4)}; "
         "hint: smallest eigenvalue, a COLUMN of the eigenvector matrix, neighbourhood centred on its mean"
     )
-    check_close(curvature, np.full(40, values[0] / values.sum()), "curvature",
-                hint="curvature = l_min / (l_1 + l_2 + l_3)")
+    check_close(
+        curvature, np.full(40, values[0] / values.sum()), "curvature", hint="curvature = l_min / (l_1 + l_2 + l_3)"
+    )
 
 
 @pytest.mark.grades("estimate_normals")
@@ -301,14 +313,18 @@ def test_estimate_normals_does_not_modify_its_input(impl):
 
 
 @pytest.mark.points(0.5)
-@pytest.mark.parametrize("kwargs, name", [
-    ({"points": np.zeros((5, 2))}, "points"),
-    ({"points": np.array([[0.0, 0, 0], [np.nan, 0, 0], [1, 1, 1]])}, "points"),
-    ({"radius": 0.0, "k": None}, "radius"),
-    ({"radius": -1.0}, "radius"),
-    ({"k": 0}, "k"),
-    ({"viewpoint": np.zeros(2)}, "viewpoint"),
-], ids=["width", "nan", "radius-zero", "radius-negative", "k-zero", "viewpoint-shape"])
+@pytest.mark.parametrize(
+    "kwargs, name",
+    [
+        ({"points": np.zeros((5, 2))}, "points"),
+        ({"points": np.array([[0.0, 0, 0], [np.nan, 0, 0], [1, 1, 1]])}, "points"),
+        ({"radius": 0.0, "k": None}, "radius"),
+        ({"radius": -1.0}, "radius"),
+        ({"k": 0}, "k"),
+        ({"viewpoint": np.zeros(2)}, "viewpoint"),
+    ],
+    ids=["width", "nan", "radius-zero", "radius-negative", "k-zero", "viewpoint-shape"],
+)
 @pytest.mark.grades("estimate_normals")
 @pytest.mark.interface
 def test_estimate_normals_rejects_bad_input(impl, kwargs, name):

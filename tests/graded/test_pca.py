@@ -60,8 +60,13 @@ def test_pca_returns_plain_float64_arrays(impl, known):
 def test_pca_eigenvalues_match_known_variances(impl, known):
     points, variances, _ = known
     eigenvalues, _ = impl.pca(points)
-    check_close(eigenvalues, variances, "eigenvalues", rtol=1e-6,
-                hint="centre each column on its own mean, divide by N (not N - 1), sort descending")
+    check_close(
+        eigenvalues,
+        variances,
+        "eigenvalues",
+        rtol=1e-6,
+        hint="centre each column on its own mean, divide by N (not N - 1), sort descending",
+    )
 
 
 @pytest.mark.grades("pca")
@@ -69,8 +74,9 @@ def test_pca_eigenvalues_match_known_variances(impl, known):
 def test_pca_eigenvectors_are_the_principal_axes(impl, known):
     points, _, rotation = known
     _, eigenvectors = impl.pca(points)
-    check_unit_columns_match(eigenvectors, rotation, "eigenvectors",
-                             hint="eigenvectors must be the COLUMNS, in the order of the eigenvalues")
+    check_unit_columns_match(
+        eigenvectors, rotation, "eigenvectors", hint="eigenvectors must be the COLUMNS, in the order of the eigenvalues"
+    )
 
 
 @pytest.mark.grades("pca")
@@ -81,10 +87,19 @@ def test_pca_columns_satisfy_the_eigen_equation(impl):
     eigenvalues, eigenvectors = impl.pca(points)
     h = population_covariance(points)
     # H @ 0 == 0 * lambda: the eigen-equation alone lets zero (or NaN) columns through.
-    check_orthonormal_columns(eigenvectors, "eigenvectors", atol=1e-8,
-                              hint="the contract: eigenvectors are orthonormal columns (np.linalg.eigh gives them)")
-    check_close(h @ eigenvectors, eigenvectors * eigenvalues, "H @ eigenvectors", atol=1e-8,
-                hint="H @ eigenvectors[:, i] must equal eigenvalues[i] * eigenvectors[:, i]")
+    check_orthonormal_columns(
+        eigenvectors,
+        "eigenvectors",
+        atol=1e-8,
+        hint="the contract: eigenvectors are orthonormal columns (np.linalg.eigh gives them)",
+    )
+    check_close(
+        h @ eigenvectors,
+        eigenvectors * eigenvalues,
+        "H @ eigenvectors",
+        atol=1e-8,
+        hint="H @ eigenvectors[:, i] must equal eigenvalues[i] * eigenvectors[:, i]",
+    )
 
 
 @pytest.mark.grades("pca")
@@ -94,8 +109,13 @@ def test_pca_centres_each_column_on_its_own_mean(impl):
     points = rng.standard_normal((500, 3)) * [1.0, 2.0, 0.5] + [1000.0, -300.0, 50.0]
     eigenvalues, _ = impl.pca(points)
     expected = np.sort(np.linalg.eigvalsh(population_covariance(points)))[::-1]
-    check_close(eigenvalues, expected, "eigenvalues", rtol=1e-6,
-                hint="subtract each column's own mean (points.mean(axis=0)) before forming H")
+    check_close(
+        eigenvalues,
+        expected,
+        "eigenvalues",
+        rtol=1e-6,
+        hint="subtract each column's own mean (points.mean(axis=0)) before forming H",
+    )
 
 
 @pytest.mark.grades("pca")
@@ -105,8 +125,7 @@ def test_pca_uses_population_normalisation(impl):
     points = rng.standard_normal((5, 3)) * [3.0, 2.0, 1.0]
     eigenvalues, _ = impl.pca(points)
     expected = np.sort(np.linalg.eigvalsh(population_covariance(points)))[::-1]
-    check_close(eigenvalues, expected, "eigenvalues", rtol=1e-6,
-                hint="H = X~^T X~ / N: divide by N, not N - 1")
+    check_close(eigenvalues, expected, "eigenvalues", rtol=1e-6, hint="H = X~^T X~ / N: divide by N, not N - 1")
 
 
 @pytest.mark.grades("pca")
@@ -145,8 +164,13 @@ def test_pca_eigenvectors_are_orthonormal_for_repeated_eigenvalues(impl):
     points = cloud_with_covariance(60, [4.0, 4.0, 1.0], random_rotation(rng, 3), 0.0, rng)
     eigenvalues, eigenvectors = impl.pca(points)
     check_close(eigenvalues, [4.0, 4.0, 1.0], "eigenvalues", rtol=1e-6)
-    check_close(eigenvectors.T @ eigenvectors, np.eye(3), "eigenvectors.T @ eigenvectors",
-                atol=1e-8, hint="use a symmetric eigensolver (np.linalg.eigh): H is symmetric")
+    check_close(
+        eigenvectors.T @ eigenvectors,
+        np.eye(3),
+        "eigenvectors.T @ eigenvectors",
+        atol=1e-8,
+        hint="use a symmetric eigensolver (np.linalg.eigh): H is symmetric",
+    )
 
 
 @pytest.mark.grades("pca")
@@ -158,8 +182,13 @@ def test_pca_correlation_matrix(impl):
     points = np.column_stack([base[:, 0] * 100.0, base[:, 0] + 0.5 * base[:, 1], base[:, 2] * 0.01])
     eigenvalues, eigenvectors = impl.pca(points, correlation=True)
     corr = np.corrcoef(points.T)
-    check_close(eigenvalues, np.sort(np.linalg.eigvalsh(corr))[::-1], "eigenvalues", rtol=1e-6,
-                hint="with correlation=True divide each centred column by its standard deviation")
+    check_close(
+        eigenvalues,
+        np.sort(np.linalg.eigvalsh(corr))[::-1],
+        "eigenvalues",
+        rtol=1e-6,
+        hint="with correlation=True divide each centred column by its standard deviation",
+    )
     check_close(corr @ eigenvectors, eigenvectors * eigenvalues, "R @ eigenvectors", atol=1e-8)
 
 
@@ -217,12 +246,16 @@ def test_pca_does_not_modify_its_input(impl, known):
 
 
 @pytest.mark.points(0.5)
-@pytest.mark.parametrize("bad, why", [
-    (np.zeros(6), "1-D"),
-    (np.zeros((2, 3, 3)), "3-D"),
-    (np.array([[0.0, 1.0, 2.0], [np.nan, 1.0, 0.0], [1.0, 1.0, 1.0]]), "NaN"),
-    (np.array([[0.0, 1.0, 2.0], [np.inf, 1.0, 0.0], [1.0, 1.0, 1.0]]), "inf"),
-], ids=["1d", "3d", "nan", "inf"])
+@pytest.mark.parametrize(
+    "bad, why",
+    [
+        (np.zeros(6), "1-D"),
+        (np.zeros((2, 3, 3)), "3-D"),
+        (np.array([[0.0, 1.0, 2.0], [np.nan, 1.0, 0.0], [1.0, 1.0, 1.0]]), "NaN"),
+        (np.array([[0.0, 1.0, 2.0], [np.inf, 1.0, 0.0], [1.0, 1.0, 1.0]]), "inf"),
+    ],
+    ids=["1d", "3d", "nan", "inf"],
+)
 @pytest.mark.grades("pca")
 @pytest.mark.interface
 def test_pca_rejects_bad_points(impl, bad, why):

@@ -12,7 +12,10 @@ def run_grader(*args, tmp_path):
     results = tmp_path / "results.json"
     completed = subprocess.run(
         [sys.executable, "-m", "grading", "grade", *args, "--results", str(results)],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=900,
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=900,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     return json.loads(results.read_text()), completed.stdout

@@ -50,9 +50,15 @@ def grade(submission, tmp_path, *args, as_user=None):
             os.chown(path, as_user, as_user)
         kwargs = {"user": as_user, "group": as_user, "extra_groups": []}
     env = {"PATH": os.environ["PATH"], "HOME": str(tmp_path), "PYTHONDONTWRITEBYTECODE": "1"}
-    completed = subprocess.run([sys.executable, "-m", "grading", "grade", str(submission), "--results",
-                                str(results), *args], cwd=REPO_ROOT, capture_output=True, text=True,
-                               timeout=900, env=env, **kwargs)
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "grade", str(submission), "--results", str(results), *args],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        env=env,
+        **kwargs,
+    )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     return json.loads(results.read_text()), completed.stdout + completed.stderr
 
@@ -65,12 +71,16 @@ def outputs(summary, prefix):
 
 # -- 1. symbolic links and other files that are not regular ---------------------------------------
 
-@pytest.mark.parametrize("target", [
-    REPO_ROOT / "solutions" / "metrics.py",    # the reference: full marks with no code
-    "/proc/self/environ",                       # the grader's environment in the feedback
-    REPO_ROOT / "tests" / "hidden",             # the hidden tests in the feedback
-    "/dev/zero",                                # a copy that never ends
-])
+
+@pytest.mark.parametrize(
+    "target",
+    [
+        REPO_ROOT / "solutions" / "metrics.py",  # the reference: full marks with no code
+        "/proc/self/environ",  # the grader's environment in the feedback
+        REPO_ROOT / "tests" / "hidden",  # the hidden tests in the feedback
+        "/dev/zero",  # a copy that never ends
+    ],
+)
 def test_a_symbolic_link_is_refused_with_one_line(tmp_path, target):
     clone = make_submission(tmp_path / "clone")
     (clone / "pcl_course" / "metrics.py").unlink()
@@ -80,8 +90,9 @@ def test_a_symbolic_link_is_refused_with_one_line(tmp_path, target):
     assert time.monotonic() - started < 120
     assert summary["score"] == 0
     for test in summary["tests"]:
-        assert test["output"].startswith("submission refused: pcl_course/metrics.py is a symbolic link: "
-                                         "submit regular files only"), test
+        assert test["output"].startswith(
+            "submission refused: pcl_course/metrics.py is a symbolic link: submit regular files only"
+        ), test
         assert "\n" not in test["output"]
     assert "Traceback" not in printed and "hunter" not in printed and "def chamfer_distance" not in printed
 
@@ -103,8 +114,7 @@ def test_other_files_that_are_not_plain_source_are_refused(tmp_path, kind):
         (package / "data.bin").write_bytes(b"0" * (64 * 1024**2))
     summary, printed = grade(clone, tmp_path, "-k", "test_chamfer_distance_")
     assert summary["score"] == 0
-    assert all(t["output"].startswith("submission refused: ") and "\n" not in t["output"]
-               for t in summary["tests"])
+    assert all(t["output"].startswith("submission refused: ") and "\n" not in t["output"] for t in summary["tests"])
     assert "Traceback" not in printed
 
 
@@ -116,9 +126,24 @@ def test_batch_never_follows_a_link_into_a_classmate(tmp_path):
     (mallory / "pcl_course" / "metrics.py").symlink_to("../../alice/pcl_course/metrics.py")
     (classroom / "eve").symlink_to("alice")  # a whole submission that is a link
     completed = subprocess.run(
-        [sys.executable, "-m", "grading", "batch", str(classroom), "--csv", str(tmp_path / "marks.csv"),
-         "--jobs", "2", "-k", "test_chamfer_distance_"],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "batch",
+            str(classroom),
+            "--csv",
+            str(tmp_path / "marks.csv"),
+            "--jobs",
+            "2",
+            "-k",
+            "test_chamfer_distance_",
+        ],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     rows = {row["submission"]: row for row in csv.DictReader(open(tmp_path / "marks.csv"))}
     assert rows["alice"]["score"] == rows["alice"]["max_score"] != "0"
@@ -128,7 +153,7 @@ def test_batch_never_follows_a_link_into_a_classmate(tmp_path):
 
 # -- 2, 3, 5, 6 and the network: what a submission can see --------------------------------------
 
-SPY = '''
+SPY = """
 import glob, json, os, socket
 
 def _readable(path):
@@ -177,7 +202,7 @@ def chamfer_distance(a, b):
     except OSError:
         found["network"] = False
     raise ValueError("SPY" + json.dumps(found) + "YPS")
-'''
+"""
 
 
 @pytest.fixture
@@ -213,14 +238,18 @@ def test_a_submission_sees_nothing_but_itself(tmp_path, loopback_server, who):
     os.chmod(tmp_path, 0o755)
     from grading.config import FORBIDDEN_PACKAGES
 
-    spy = SPY.format(repo=str(REPO_ROOT), classmate=str(classmate), forbidden=list(FORBIDDEN_PACKAGES),
-                     port=port)
+    spy = SPY.format(repo=str(REPO_ROOT), classmate=str(classmate), forbidden=list(FORBIDDEN_PACKAGES), port=port)
     clone = make_submission(tmp_path / "clone", {"metrics.py": spy})
     os.chmod(tmp_path / "clone", 0o755)
-    summary, _ = grade(clone, tmp_path, "-k", "test_chamfer_distance_hand_computed",
-                       as_user=UNPRIVILEGED_UID if who == "unprivileged" else None)
+    summary, _ = grade(
+        clone,
+        tmp_path,
+        "-k",
+        "test_chamfer_distance_hand_computed",
+        as_user=UNPRIVILEGED_UID if who == "unprivileged" else None,
+    )
     output = summary["tests"][0]["output"]
-    found = json.loads(output[output.index("SPY") + 3:output.index("YPS")])
+    found = json.loads(output[output.index("SPY") + 3 : output.index("YPS")])
     assert found == {"readable": [], "writable": [], "processes": [], "forbidden": [], "network": False}
     assert not accepted
     assert summary["output"].startswith("isolated: bubblewrap")
@@ -231,7 +260,7 @@ def test_the_grader_never_opens_a_path_the_worker_names(tmp_path):
     import numpy as np
 
     np.savez(planted, secret=np.arange(5.0))
-    forger = f'''
+    forger = f"""
     import json, os, stat, struct
     def chamfer_distance(a, b):
         header = json.dumps({{"ok": True, "value": {{"t": "ndarray", "k": "secret"}}, "npz": {str(planted)!r},
@@ -243,7 +272,7 @@ def test_the_grader_never_opens_a_path_the_worker_names(tmp_path):
             except OSError:
                 pass
         return 8.5
-    '''
+    """
     clone = make_submission(tmp_path / "clone", {"metrics.py": forger})
     summary, printed = grade(clone, tmp_path, "-k", "test_chamfer_distance_hand_computed")
     assert planted.exists()
@@ -258,7 +287,8 @@ def test_a_package_that_shadows_a_module_is_scanned(tmp_path):
     (clone / "pcl_course" / "metrics" / "__init__.py").write_text("from .core import chamfer_distance\n")
     (clone / "pcl_course" / "metrics" / "core.py").write_text(
         "import numpy as np\nfrom sklearn.neighbors import NearestNeighbors\n\n"
-        "def chamfer_distance(a, b):\n    return 8.5\n")
+        "def chamfer_distance(a, b):\n    return 8.5\n"
+    )
     summary, _ = grade(clone, tmp_path, "-k", "test_chamfer_distance_hand_computed")
     assert summary["score"] == 0
     assert summary["tests"][0]["output"].startswith("forbidden API in metrics.py (core.py:2")
@@ -266,7 +296,7 @@ def test_a_package_that_shadows_a_module_is_scanned(tmp_path):
 
 # -- 3. a daemon left behind in batch -------------------------------------------------------------
 
-DAEMON = '''
+DAEMON = """
 import os, signal, time
 import numpy as np
 
@@ -286,7 +316,7 @@ def chamfer_distance(a, b):
         os._exit(0)
     time.sleep(0.5)
     return 8.5
-'''
+"""
 
 
 def test_a_daemon_left_in_batch_dies_with_its_worker(tmp_path):
@@ -295,9 +325,24 @@ def test_a_daemon_left_in_batch_dies_with_its_worker(tmp_path):
     make_submission(classroom / "b-bob")
     make_submission(classroom / "c-carol")
     completed = subprocess.run(
-        [sys.executable, "-m", "grading", "batch", str(classroom), "--csv", str(tmp_path / "marks.csv"),
-         "--jobs", "1", "-k", "test_chamfer_distance_"],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "batch",
+            str(classroom),
+            "--csv",
+            str(tmp_path / "marks.csv"),
+            "--jobs",
+            "1",
+            "-k",
+            "test_chamfer_distance_",
+        ],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     rows = {row["submission"]: row for row in csv.DictReader(open(tmp_path / "marks.csv"))}
     for honest in ("b-bob", "c-carol"):
@@ -307,11 +352,11 @@ def test_a_daemon_left_in_batch_dies_with_its_worker(tmp_path):
 
 # -- import failures, in-place changes ------------------------------------------------------------
 
+
 def test_a_module_that_hangs_at_import_is_detected_once(tmp_path):
     clone = make_submission(tmp_path / "clone", {"metrics.py": "import time\ntime.sleep(3600)\n"})
     started = time.monotonic()
-    summary, _ = grade(clone, tmp_path, "-k", "test_chamfer_distance_ or test_depth_metrics_",
-                       "--call-timeout", "3")
+    summary, _ = grade(clone, tmp_path, "-k", "test_chamfer_distance_ or test_depth_metrics_", "--call-timeout", "3")
     elapsed = time.monotonic() - started
     tests = summary["tests"]
     assert len(tests) > 5 and all(t["score"] == 0 for t in tests)
@@ -323,9 +368,25 @@ def test_a_module_that_hangs_at_import_is_detected_once(tmp_path):
 
 def test_an_input_modified_in_place_fails_as_it_does_locally(tmp_path):
     mutant = REPO_ROOT / "tests" / "mutants" / "pca" / "modifies_input.py"
-    local = subprocess.run([sys.executable, "-m", "grading", "grade", "--reference", "--impl-module",
-                            f"pca={mutant}", "-k", "test_pca_", "--results", str(tmp_path / "local.json")],
-                           cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+    local = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "grade",
+            "--reference",
+            "--impl-module",
+            f"pca={mutant}",
+            "-k",
+            "test_pca_",
+            "--results",
+            str(tmp_path / "local.json"),
+        ],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert local.returncode == 0, local.stderr
     # The reference module with the mutant's pca defined after it (what a student would submit).
     wrong = "\n".join(line for line in mutant.read_text().splitlines() if not line.startswith("from solutions."))

@@ -19,15 +19,33 @@ def make_submission(root, name, exercises_from):
 def test_batch_grades_every_submission_and_writes_a_csv(tmp_path):
     classroom = tmp_path / "class"
     make_submission(classroom, "alice", [REPO_ROOT / "solutions" / "metrics.py"])  # right
-    make_submission(classroom, "bob", [])                                         # stubs
+    make_submission(classroom, "bob", [])  # stubs
     carol = make_submission(classroom, "carol", [REPO_ROOT / "solutions" / "metrics.py"])
-    (carol / "metrics.py").write_text((carol / "metrics.py").read_text().replace(
-        "np.mean(a_to_b**2) + np.mean(b_to_a**2)", "np.mean(a_to_b) + np.mean(b_to_a)"))  # unsquared
+    (carol / "metrics.py").write_text(
+        (carol / "metrics.py")
+        .read_text()
+        .replace("np.mean(a_to_b**2) + np.mean(b_to_a**2)", "np.mean(a_to_b) + np.mean(b_to_a)")
+    )  # unsquared
     (classroom / "notes.txt").write_text("not a submission")
     completed = subprocess.run(
-        [sys.executable, "-m", "grading", "batch", str(classroom), "--csv", str(tmp_path / "marks.csv"),
-         "--jobs", "2", "-k", "test_chamfer_distance_ or test_depth_metrics_"],
-        cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "batch",
+            str(classroom),
+            "--csv",
+            str(tmp_path / "marks.csv"),
+            "--jobs",
+            "2",
+            "-k",
+            "test_chamfer_distance_ or test_depth_metrics_",
+        ],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     rows = {row["submission"]: row for row in csv.DictReader(open(tmp_path / "marks.csv"))}
     assert set(rows) == {"alice", "bob", "carol"}

@@ -19,10 +19,28 @@ def small_run(tmp_path_factory):
     """The whole pipeline on tiny clouds: pytest-benchmark, then the report."""
     out = tmp_path_factory.mktemp("bench")
     command = [
-        sys.executable, "-m", "pytest", "benchmarks", "-q", "-p", "no:xdist", "-p", "no:dash",
-        "-p", "no:cacheprovider", "-o", "addopts=", "-o", "timeout=0",
-        "--bench-sizes=1500", "--bench-kernel-sizes=200", "--bench-datasets=cube,scan", "--bench-blocks=2",
-        "--bench-block-seconds=0.005", f"--benchmark-json={out / 'raw.json'}", "--benchmark-save-data",
+        sys.executable,
+        "-m",
+        "pytest",
+        "benchmarks",
+        "-q",
+        "-p",
+        "no:xdist",
+        "-p",
+        "no:dash",
+        "-p",
+        "no:cacheprovider",
+        "-o",
+        "addopts=",
+        "-o",
+        "timeout=0",
+        "--bench-sizes=1500",
+        "--bench-kernel-sizes=200",
+        "--bench-datasets=cube,scan",
+        "--bench-blocks=2",
+        "--bench-block-seconds=0.005",
+        f"--benchmark-json={out / 'raw.json'}",
+        "--benchmark-save-data",
     ]
     # A clean environment: under pytest-xdist the PYTEST_* variables of the
     # worker would make pytest-benchmark disable itself in the child.
@@ -30,8 +48,13 @@ def small_run(tmp_path_factory):
     run = subprocess.run(command, cwd=REPO_ROOT, capture_output=True, text=True, timeout=600, env=env)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert (out / "raw.json").is_file(), run.stdout[-3000:]
-    report = subprocess.run([sys.executable, "-m", "benchmarks.report", str(out / "raw.json"), str(out / "results")],
-                            cwd=REPO_ROOT, capture_output=True, text=True, timeout=120)
+    report = subprocess.run(
+        [sys.executable, "-m", "benchmarks.report", str(out / "raw.json"), str(out / "results")],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert report.returncode == 0, report.stderr
     raw = json.loads((out / "raw.json").read_text())
     return raw, json.loads((out / "results" / "results.json").read_text()), (out / "results" / "results.md").read_text()
@@ -39,7 +62,10 @@ def small_run(tmp_path_factory):
 
 def test_blocks_alternate_between_the_implementations(small_run):
     raw, _, _ = small_run
-    order = [(b["extra_info"]["case"], b["extra_info"]["block"], b["extra_info"]["implementation"]) for b in raw["benchmarks"]]
+    order = [
+        (b["extra_info"]["case"], b["extra_info"]["block"], b["extra_info"]["implementation"])
+        for b in raw["benchmarks"]
+    ]
     first_case = order[0][0]
     sequence = [(block, name) for case, block, name in order if case == first_case]
     names = [name for block, name in sequence if block == 0]
@@ -54,8 +80,11 @@ def test_report_pools_both_blocks_and_compares_with_every_peer(small_run):
     for case in results["cases"]:
         assert case["blocks"] == 2
         assert "reference" in case["results"] and set(case["ratios"]) == set(case["results"]) - {"reference"}
-        rounds = [b["stats"]["rounds"] for b in raw["benchmarks"]
-                  if b["extra_info"]["case"] == case["case"] and b["extra_info"]["implementation"] == "reference"]
+        rounds = [
+            b["stats"]["rounds"]
+            for b in raw["benchmarks"]
+            if b["extra_info"]["case"] == case["case"] and b["extra_info"]["implementation"] == "reference"
+        ]
         assert case["results"]["reference"]["rounds"] == sum(rounds)
         for name, ratio in case["ratios"].items():
             expected = case["results"]["reference"]["median_s"] / case["results"][name]["median_s"]
@@ -73,6 +102,10 @@ def test_committed_results_cover_every_target():
         assert case.id in measured, f"{case.id} missing from {RESULTS.name}: run make bench"
         entry = measured[case.id]
         peer, limit = case.target
-        assert entry["target"] == {"peer": peer, "limit": limit, "ratio": entry["ratios"][peer],
-                                   "met": entry["ratios"][peer] <= limit}
+        assert entry["target"] == {
+            "peer": peer,
+            "limit": limit,
+            "ratio": entry["ratios"][peer],
+            "met": entry["ratios"][peer] <= limit,
+        }
     assert markdown(results).count("\n|") > len(targets)

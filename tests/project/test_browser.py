@@ -11,18 +11,24 @@ import shutil
 import threading
 
 import pytest
+from test_book import HTML, page, pytestmark, toc_files  # noqa: F401 -- pytestmark: skip without a book
 
 from grading import REPO_ROOT
-from test_book import HTML, page, toc_files
 
 CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
 SCREENSHOTS = REPO_ROOT / "_build" / "screenshots"
 CHROMIUM_ARGS = [
-    "--headless", "--no-sandbox", "--disable-gpu",
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
     # software WebGL, for Plotly's 3-D figures without a GPU
-    "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+    "--use-angle=swiftshader",
+    "--enable-unsafe-swiftshader",
     # no calls home: this machine has no network, and the book must not need one
-    "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
 ]
 
 
@@ -59,8 +65,10 @@ def test_page_in_a_real_browser(name, site, browser):
     errors, remote = [], []
     tab.on("console", lambda message: errors.append(message.text) if message.type == "error" else None)
     tab.on("pageerror", lambda error: errors.append(str(error)))
-    tab.on("request", lambda request: remote.append(request.url)
-           if not request.url.startswith((site, "data:", "blob:")) else None)
+    tab.on(
+        "request",
+        lambda request: remote.append(request.url) if not request.url.startswith((site, "data:", "blob:")) else None,
+    )
     tab.goto(f"{site}/{name}.html", wait_until="load")
 
     if 'class="math' in html:
@@ -70,8 +78,7 @@ def test_page_in_a_real_browser(name, site, browser):
 
     figures = html.count('class="plotly-graph-div"')
     if figures:
-        tab.wait_for_function(
-            f"document.querySelectorAll('.js-plotly-plot canvas').length >= {figures}", timeout=30000)
+        tab.wait_for_function(f"document.querySelectorAll('.js-plotly-plot canvas').length >= {figures}", timeout=30000)
         assert tab.locator(".js-plotly-plot").count() == figures, f"{name}: not every Plotly figure started"
 
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)

@@ -39,8 +39,9 @@ def test_book_states_the_points_the_grader_gives(page, points, keyword, referenc
     summary, _ = reference_grading
     alternatives = [k.strip() for k in keyword.split(" or ")]
     # The book states the public tests' points; hidden tests come on top.
-    selected = [t for t in summary["tests"]
-                if any(k in t["name"] for k in alternatives) and t["visibility"] == "visible"]
+    selected = [
+        t for t in summary["tests"] if any(k in t["name"] for k in alternatives) and t["visibility"] == "visible"
+    ]
     assert selected, f"{page}: -k {keyword!r} selects no graded test"
     assert sum(t["max_score"] for t in selected) == points, (
         f"{page} says {points} points for -k {keyword!r}, the grader gives {sum(t['max_score'] for t in selected)}"

@@ -5,7 +5,11 @@ import pytest
 
 from pcl_course import datasets
 from pcl_course.io import (
-    read_kitti_bin, read_kitti_depth_png, read_modelnet_txt, write_kitti_bin, write_kitti_depth_png,
+    read_kitti_bin,
+    read_kitti_depth_png,
+    read_modelnet_txt,
+    write_kitti_bin,
+    write_kitti_depth_png,
     write_modelnet_txt,
 )
 
@@ -112,8 +116,9 @@ def test_modelnet_text_round_trip(tmp_path):
 
 
 def test_mini_modelnet_layout_and_loader(tmp_path):
-    root = datasets.make_mini_modelnet(tmp_path / "mini", n_per_class=3, n_test_per_class=1, n_points=256,
-                                       classes=("chair", "mug"))
+    root = datasets.make_mini_modelnet(
+        tmp_path / "mini", n_per_class=3, n_test_per_class=1, n_points=256, classes=("chair", "mug")
+    )
     assert (root / "modelnet40_shape_names.txt").read_text().split() == ["chair", "mug"]
     assert (root / "chair" / "chair_0003.txt").is_file()
     train = datasets.load_modelnet(root, "train")

@@ -67,7 +67,13 @@ def test_voxel_grid_centroids_equal_the_plain_groups(voxel_size, strategy):
     points = np.c_[RNG.random((4000, 3)) * [1.0, 2.0, 3.0], RNG.random(4000)]
     h, dims = downsampling.voxel_coordinates(points[:, :3], voxel_size)
     cells = dims[0] * dims[1] * dims[2]
-    used = "dense table" if cells <= 8 * len(points) else "hashed int64 keys" if cells < 2**63 else "lexicographic, beyond int64"
+    used = (
+        "dense table"
+        if cells <= 8 * len(points)
+        else "hashed int64 keys"
+        if cells < 2**63
+        else "lexicographic, beyond int64"
+    )
     assert used == strategy
     expected = plain.voxel_grid_centroids(points, voxel_size)
     result = downsampling.voxel_grid_downsample(points, voxel_size)
@@ -84,12 +90,15 @@ def test_voxel_grid_random_rows_come_one_from_each_voxel_in_order(voxel_size):
         assert any(np.array_equal(row, points[m]) for m in members)
 
 
-@pytest.mark.parametrize("keys", [
-    RNG.integers(0, 50, 5000),                       # few keys, many repeats
-    RNG.integers(0, 2**62, 3000),                    # all distinct
-    np.arange(0, 2**40, 2**30),                      # a stride that collides in a small table
-    np.repeat(RNG.integers(0, 10**12, 400), 5),      # runs of equal keys (the scan case)
-])
+@pytest.mark.parametrize(
+    "keys",
+    [
+        RNG.integers(0, 50, 5000),  # few keys, many repeats
+        RNG.integers(0, 2**62, 3000),  # all distinct
+        np.arange(0, 2**40, 2**30),  # a stride that collides in a small table
+        np.repeat(RNG.integers(0, 10**12, 400), 5),  # runs of equal keys (the scan case)
+    ],
+)
 def test_hash_groups_numbers_keys_by_first_appearance(keys):
     keys = np.ascontiguousarray(keys, dtype=np.int64)
     groups, uniques = hash_groups(keys)
@@ -189,7 +198,9 @@ def test_estimate_normals_matches_the_plain_eigh(name, k, radius):
     result_normals, result_curvature = normals.estimate_normals(points, k=k, radius=radius)
     finite = np.isfinite(expected_curvature)
     np.testing.assert_array_equal(np.isfinite(result_curvature), finite)
-    np.testing.assert_allclose(np.abs(np.sum(result_normals[finite] * expected_normals[finite], axis=1)), 1.0, atol=1e-8)
+    np.testing.assert_allclose(
+        np.abs(np.sum(result_normals[finite] * expected_normals[finite], axis=1)), 1.0, atol=1e-8
+    )
     np.testing.assert_allclose(result_curvature[finite], expected_curvature[finite], rtol=1e-9, atol=1e-12)
 
 
@@ -233,7 +244,9 @@ def test_grid_radius_count_equals_the_kdtree_count(name, relative_radius):
 def test_grid_radius_count_includes_neighbours_at_exactly_the_radius():
     lattice = CLOUDS["lattice"]  # unit spacing: many pairs exactly 1 and sqrt(2) apart
     for radius in (1.0, np.sqrt(2.0), 2.0):
-        np.testing.assert_array_equal(grid_radius_count(lattice, radius) - 1, plain.radius_neighbour_counts(lattice, radius))
+        np.testing.assert_array_equal(
+            grid_radius_count(lattice, radius) - 1, plain.radius_neighbour_counts(lattice, radius)
+        )
 
 
 def test_radius_outlier_removal_falls_back_to_the_tree_for_huge_grids():
@@ -264,5 +277,7 @@ def test_kernel_pca_lanczos_matches_the_dense_solver(kernel, beta):
     centred = gram - ones @ gram - gram @ ones + ones @ gram @ ones
     values, vectors = plain.kernel_pca_eigenpairs(centred, 3)
     np.testing.assert_allclose(eigenvalues, values, rtol=1e-9)
-    np.testing.assert_allclose(np.abs(alphas.T @ vectors), np.diag(1.0 / np.sqrt(values)), atol=1e-7 / np.sqrt(values.min()))
+    np.testing.assert_allclose(
+        np.abs(alphas.T @ vectors), np.diag(1.0 / np.sqrt(values)), atol=1e-7 / np.sqrt(values.min())
+    )
     np.testing.assert_allclose(projections, centred @ alphas, atol=1e-9 * np.abs(projections).max())

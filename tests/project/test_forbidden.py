@@ -9,30 +9,36 @@ from grading import REPO_ROOT
 from grading.forbidden import scan_package, scan_source
 
 
-@pytest.mark.parametrize("source", [
-    "import open3d",
-    "import open3d as o3d",
-    "import sklearn.decomposition",
-    "from sklearn.decomposition import PCA",
-    "from sklearn import decomposition as d",
-    "x = __import__('open3d')",
-    "import importlib\nm = importlib.import_module('sklearn.decomposition')",
-    "import importlib as il\nm = il.import_module('open' + '3d')",
-    "from importlib import import_module as im\nm = im(f'open3d')",
-    "def f():\n    import open3d\n    return open3d",
-    "import importlib\nname = 'open3d'\nm = importlib.import_module(name)",
-])
+@pytest.mark.parametrize(
+    "source",
+    [
+        "import open3d",
+        "import open3d as o3d",
+        "import sklearn.decomposition",
+        "from sklearn.decomposition import PCA",
+        "from sklearn import decomposition as d",
+        "x = __import__('open3d')",
+        "import importlib\nm = importlib.import_module('sklearn.decomposition')",
+        "import importlib as il\nm = il.import_module('open' + '3d')",
+        "from importlib import import_module as im\nm = im(f'open3d')",
+        "def f():\n    import open3d\n    return open3d",
+        "import importlib\nname = 'open3d'\nm = importlib.import_module(name)",
+    ],
+)
 def test_forbidden_imports_are_found(source):
     assert scan_source(source), source
 
 
-@pytest.mark.parametrize("source", [
-    "import numpy as np\nfrom scipy.spatial import cKDTree",
-    "from scipy.linalg import eigh",
-    "from . import validation\nfrom pcl_course.neighbors import knn",
-    "import math, numbers",
-    "s = 'import open3d'  # a string is not an import",
-])
+@pytest.mark.parametrize(
+    "source",
+    [
+        "import numpy as np\nfrom scipy.spatial import cKDTree",
+        "from scipy.linalg import eigh",
+        "from . import validation\nfrom pcl_course.neighbors import knn",
+        "import math, numbers",
+        "s = 'import open3d'  # a string is not an import",
+    ],
+)
 def test_allowed_code_is_not_flagged(source):
     assert scan_source(source) == [], source
 
@@ -46,8 +52,7 @@ def test_the_reference_and_the_stubs_are_clean():
 def test_a_modified_helper_is_scanned_and_taints_its_importers(tmp_path):
     package = tmp_path / "clone" / "pcl_course"
     shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
-    (package / "neighbors.py").write_text(
-        (package / "neighbors.py").read_text() + "\nimport open3d as _o3d\n")
+    (package / "neighbors.py").write_text((package / "neighbors.py").read_text() + "\nimport open3d as _o3d\n")
     (package / "normals.py").write_text("from .neighbors import knn\n" + (package / "normals.py").read_text())
     violations = scan_package(package, REPO_ROOT / "pcl_course")
     assert violations["neighbors"] and violations["normals"], violations
@@ -58,9 +63,11 @@ def test_a_forbidden_import_costs_the_whole_module_with_a_clear_message(tmp_path
     package = tmp_path / "clone" / "pcl_course"
     shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
     (package / "metrics.py").write_text(
-        "from sklearn.metrics import mean_squared_error\n" + (REPO_ROOT / "solutions" / "metrics.py").read_text())
-    summary, stdout = run_grader(str(tmp_path / "clone"), "-k", "test_chamfer_distance_ or test_pca_",
-                                 tmp_path=tmp_path)
+        "from sklearn.metrics import mean_squared_error\n" + (REPO_ROOT / "solutions" / "metrics.py").read_text()
+    )
+    summary, stdout = run_grader(
+        str(tmp_path / "clone"), "-k", "test_chamfer_distance_ or test_pca_", tmp_path=tmp_path
+    )
     chamfer = [t for t in summary["tests"] if "chamfer" in t["name"]]
     assert chamfer and all(t["score"] == 0 and "forbidden API in metrics.py" in t["output"] for t in chamfer)
     assert "metrics.py:1: from sklearn.metrics import ..." in chamfer[0]["output"]

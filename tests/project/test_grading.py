@@ -9,6 +9,7 @@ from conftest import run_grader as grade
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT
 
+
 def test_reference_gets_full_marks(reference_grading):
     summary, stdout = reference_grading
     failed = [f"{t['name']}: {t['output']}" for t in summary["tests"] if t["status"] != "passed"]
@@ -49,8 +50,21 @@ def test_every_graded_test_names_its_function(reference_grading):
 def test_a_graded_test_without_its_marker_stops_the_run(tmp_path):
     test_file = tmp_path / "test_unmarked.py"
     test_file.write_text("def test_pca_something(impl):\n    pass\n")
-    command = [sys.executable, "-m", "pytest", str(test_file), "-c", str(REPO_ROOT / "grading" / "pytest.ini"),
-               "--rootdir", str(tmp_path), "-p", "grading.plugin", "-p", "no:cacheprovider", "-q"]
+    command = [
+        sys.executable,
+        "-m",
+        "pytest",
+        str(test_file),
+        "-c",
+        str(REPO_ROOT / "grading" / "pytest.ini"),
+        "--rootdir",
+        str(tmp_path),
+        "-p",
+        "grading.plugin",
+        "-p",
+        "no:cacheprovider",
+        "-q",
+    ]
     completed = subprocess.run(command, cwd=REPO_ROOT, capture_output=True, text=True)
     assert completed.returncode == 4, completed.stdout + completed.stderr
     assert "every graded test needs @pytest.mark.grades" in completed.stdout + completed.stderr
@@ -62,8 +76,12 @@ def test_keyword_selects_one_exercise(tmp_path):
 
 
 def test_no_matching_test_is_a_usage_error():
-    completed = subprocess.run([sys.executable, "-m", "grading", "grade", "--reference", "-k", "no_such_test"],
-                               cwd=REPO_ROOT, capture_output=True, text=True)
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "grade", "--reference", "-k", "no_such_test"],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+    )
     assert completed.returncode == 2 and "no graded test matches" in completed.stderr
 
 
@@ -72,8 +90,14 @@ def grade_one_function(module_file, tmp_path):
     the reference standing in for the rest, with that function's tests only."""
     function = module_file.parent.name
     assert function in GRADED_FUNCTIONS, f"{module_file}: its folder must be named after a graded function"
-    summary, _ = grade("--reference", "--impl-module", f"{GRADED_FUNCTIONS[function]}={module_file}",
-                       "-k", f"test_{function}_", tmp_path=tmp_path)
+    summary, _ = grade(
+        "--reference",
+        "--impl-module",
+        f"{GRADED_FUNCTIONS[function]}={module_file}",
+        "-k",
+        f"test_{function}_",
+        tmp_path=tmp_path,
+    )
     assert summary["tests"], f"no test of {function} ran"
     return summary
 
@@ -108,9 +132,14 @@ def test_every_graded_function_has_wrong_and_alternative_submissions():
 
 
 def test_hidden_tests_run_when_grading_and_withhold_their_details(tmp_path):
-    summary, _ = grade("--reference", "--impl-module",
-                       f"metrics={REPO_ROOT / 'tests' / 'mutants' / 'chamfer_distance' / 'unsquared.py'}",
-                       "-k", "test_chamfer_distance_", tmp_path=tmp_path)
+    summary, _ = grade(
+        "--reference",
+        "--impl-module",
+        f"metrics={REPO_ROOT / 'tests' / 'mutants' / 'chamfer_distance' / 'unsquared.py'}",
+        "-k",
+        "test_chamfer_distance_",
+        tmp_path=tmp_path,
+    )
     hidden = [t for t in summary["tests"] if t["visibility"] == "after_published"]
     assert hidden and all(t["status"] == "failed" and "_hidden_" in t["name"] for t in hidden)
     assert all("hidden test: details withheld" in t["output"] and "\n" not in t["output"] for t in hidden)
@@ -118,13 +147,27 @@ def test_hidden_tests_run_when_grading_and_withhold_their_details(tmp_path):
 
 def test_junit_xml_is_written(tmp_path):
     completed = subprocess.run(
-        [sys.executable, "-m", "grading", "grade", "--reference", "-k", "test_pca_", "--junit",
-         str(tmp_path / "results.xml")], cwd=REPO_ROOT, capture_output=True, text=True)
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "grade",
+            "--reference",
+            "-k",
+            "test_pca_",
+            "--junit",
+            str(tmp_path / "results.xml"),
+        ],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+    )
     assert completed.returncode == 0
     assert "<testsuite" in (tmp_path / "results.xml").read_text()
 
 
 # -- degenerate answers (tests/mutants/degenerate.py) ---------------------------------------------
+
 
 def _graded_test_functions():
     """Test name -> test function, for every graded test module (public and hidden)."""
@@ -161,6 +204,7 @@ def test_a_degenerate_answer_fails_every_test_of_values(function, kind, tmp_path
     summary = grade_one_function(module_file, tmp_path)
     tests = _graded_test_functions()
     own = [t for t in summary["tests"] if t["tags"] == [function]]
-    passed = [t["name"] for t in own if t["status"] == "passed"
-              and not _is_interface_test(tests[t["name"].split("[")[0]])]
+    passed = [
+        t["name"] for t in own if t["status"] == "passed" and not _is_interface_test(tests[t["name"].split("[")[0]])
+    ]
     assert not passed, f"a {kind} answer of {function} passes tests of values: {passed}"

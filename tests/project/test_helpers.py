@@ -12,13 +12,16 @@ def test_as_points_returns_float64_and_accepts_lists():
     assert type(points) is np.ndarray and points.dtype == np.float64 and points.shape == (2, 3)
 
 
-@pytest.mark.parametrize("bad, fragment", [
-    (np.zeros(3), "dimension"),
-    (np.zeros((2, 2)), "columns"),
-    ([[1.0, np.nan, 0.0]], "finite"),
-    ([[1.0, 2.0], [3.0]], "numeric"),
-    ("abc", "numeric"),
-])
+@pytest.mark.parametrize(
+    "bad, fragment",
+    [
+        (np.zeros(3), "dimension"),
+        (np.zeros((2, 2)), "columns"),
+        ([[1.0, np.nan, 0.0]], "finite"),
+        ([[1.0, 2.0], [3.0]], "numeric"),
+        ("abc", "numeric"),
+    ],
+)
 def test_as_points_errors_name_the_argument(bad, fragment):
     with pytest.raises(ValueError, match="cloud") as excinfo:
         validation.as_points(bad, name="cloud")

@@ -17,22 +17,40 @@ from grading.leakcheck import find_leaks
 @pytest.fixture(scope="module")
 def release_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("release") / "student"
-    completed = subprocess.run([sys.executable, "-m", "grading", "release", str(out)],
-                               cwd=REPO_ROOT, capture_output=True, text=True, timeout=600)
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "release", str(out)],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     return out
 
 
 def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
-    for needed in ("Makefile", "README.md", "requirements.txt", "pyproject.toml", "_config.yml", "_toc.yml",
-                   ".ci/run", ".github/workflows/check.yml", "scripts/system-deps.sh",
-                   "pcl_course/pca.py", "grading/cli.py", "tests/graded/test_pca.py", "book/pca.md"):
+    for needed in (
+        "Makefile",
+        "README.md",
+        "requirements.txt",
+        "pyproject.toml",
+        "_config.yml",
+        "_toc.yml",
+        ".ci/run",
+        ".github/workflows/check.yml",
+        "scripts/system-deps.sh",
+        "pcl_course/pca.py",
+        "grading/cli.py",
+        "tests/graded/test_pca.py",
+        "book/pca.md",
+    ):
         assert (release_dir / needed).exists(), needed
     for absent in ("solutions", "tests/mutants", "tests/alternatives", "tests/project", "tests/hidden", ".git"):
         assert not (release_dir / absent).exists(), absent
     for module in EXERCISE_MODULES:
-        assert (release_dir / "pcl_course" / f"{module}.py").read_bytes() == \
-            (REPO_ROOT / "pcl_course" / f"{module}.py").read_bytes()
+        assert (release_dir / "pcl_course" / f"{module}.py").read_bytes() == (
+            REPO_ROOT / "pcl_course" / f"{module}.py"
+        ).read_bytes()
     assert "REFERENCE_PACKAGE = None" in (release_dir / "pcl_course" / "book.py").read_text()
 
 
@@ -56,7 +74,7 @@ def test_the_leak_check_sees_through_renaming(release_dir, tmp_path):
         "from scipy.spatial import cKDTree\n"
         "from pcl_course.validation import as_points\n\n\n"
         "def chamfer_distance(p, q):\n"
-        "    \"\"\"My own work.\"\"\"\n"
+        '    """My own work."""\n'
         "    p = as_points(p, 'a', allow_empty=False)[:, :3]\n"
         "    q = as_points(q, 'b', allow_empty=False)[:, :3]\n"
         "    there = cKDTree(q).query(p)[0]\n"
@@ -95,8 +113,13 @@ def test_the_workflow_names_the_course_repository_when_given(tmp_path):
 
 
 def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
-    completed = subprocess.run([sys.executable, "-m", "grading", "grade", ".", "--results", "r.json"],
-                               cwd=release_dir, capture_output=True, text=True, timeout=600)
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "grade", ".", "--results", "r.json"],
+        cwd=release_dir,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     summary = json.loads((release_dir / "r.json").read_text())
     assert summary["score"] == 0 and summary["max_score"] > 0
@@ -108,9 +131,14 @@ def test_the_release_book_builds_with_the_stubs(release_dir):
     # The release's own pcl_course first on the path: the kernel must run the
     # stubs, as in a student's fresh environment (where no solutions exist).
     env = dict(__import__("os").environ, PYTHONPATH=str(release_dir))
-    completed = subprocess.run([str(REPO_ROOT / ".venv" / "bin" / "jupyter-book"), "build", ".", "-n",
-                                "--keep-going"], cwd=release_dir, capture_output=True, text=True,
-                               timeout=900, env=env)
+    completed = subprocess.run(
+        [str(REPO_ROOT / ".venv" / "bin" / "jupyter-book"), "build", ".", "-n", "--keep-going"],
+        cwd=release_dir,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        env=env,
+    )
     assert completed.returncode == 0, completed.stdout[-3000:] + completed.stderr[-3000:]
     page = (release_dir / "_build" / "html" / "book" / "pca.html").read_text()
     assert "Not implemented yet: pca" in page
@@ -132,8 +160,14 @@ def test_the_workflow_grade_step_runs_the_pristine_grader_on_the_submission(rele
     workflow = yaml.safe_load((release_dir / ".github" / "workflows" / "check.yml").read_text())
     step = next(s for s in workflow["jobs"]["check"]["steps"] if "python -m grading grade" in s.get("run", ""))
     env = dict(__import__("os").environ, PATH=f"{REPO_ROOT / '.venv' / 'bin'}:{__import__('os').environ['PATH']}")
-    completed = subprocess.run(["bash", "-e", "-c", step["run"]], cwd=workspace / step["working-directory"],
-                               capture_output=True, text=True, timeout=600, env=env)
+    completed = subprocess.run(
+        ["bash", "-e", "-c", step["run"]],
+        cwd=workspace / step["working-directory"],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        env=env,
+    )
     assert completed.returncode == 0, completed.stdout[-2000:] + completed.stderr[-2000:]
     summary = json.loads((workspace / "results" / "results.json").read_text())
     metrics = [t for t in summary["tests"] if t["name"].startswith(("test_chamfer_distance_", "test_depth_metrics_"))]

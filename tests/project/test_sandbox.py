@@ -19,7 +19,8 @@ from grading.staging import stage
 def namespace_available():
     return isolation().level == "bubblewrap"
 
-EVIL = textwrap.dedent('''
+
+EVIL = textwrap.dedent("""
     import os, sys, time
     import numpy as np
 
@@ -96,7 +97,7 @@ EVIL = textwrap.dedent('''
 
     def value_error():
         raise ValueError("points must be 2-D")
-''').replace("REPO", repr(str(REPO_ROOT)))
+""").replace("REPO", repr(str(REPO_ROOT)))
 
 
 @pytest.fixture
@@ -125,8 +126,19 @@ def test_student_exceptions_keep_their_type_and_the_worker(worker):
     assert worker.call("evil", "echo", (1,), {}) == 1 and worker.process.pid == pid
 
 
-@pytest.mark.parametrize("function", ["loop_forever", "memory_bomb", "fork_bomb", "hard_exit",
-                                      "exit_zero", "keyboard_interrupt", "subclass", "always_equal"])
+@pytest.mark.parametrize(
+    "function",
+    [
+        "loop_forever",
+        "memory_bomb",
+        "fork_bomb",
+        "hard_exit",
+        "exit_zero",
+        "keyboard_interrupt",
+        "subclass",
+        "always_equal",
+    ],
+)
 def test_hostile_calls_fail_alone(worker, function):
     worker.timeout = 5
     with pytest.raises(SandboxError):
@@ -143,9 +155,22 @@ def test_the_environment_is_stripped(worker, monkeypatch):
     worker.stop()
     environment = worker.call("evil", "environment", (), {})
     assert "GRADER_SECRET_TOKEN" not in environment and set(environment) <= {
-        "PATH", "HOME", "LANG", "TMPDIR", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
-        "OPEN3D_DISABLE_WEB_VISUALIZER", "MPLBACKEND", "NUMBA_NUM_THREADS", "NUMBA_CACHE_DIR", "LC_CTYPE",
-        "PWD", "SHLVL", "_"}
+        "PATH",
+        "HOME",
+        "LANG",
+        "TMPDIR",
+        "OMP_NUM_THREADS",
+        "OPENBLAS_NUM_THREADS",
+        "MKL_NUM_THREADS",
+        "OPEN3D_DISABLE_WEB_VISUALIZER",
+        "MPLBACKEND",
+        "NUMBA_NUM_THREADS",
+        "NUMBA_CACHE_DIR",
+        "LC_CTYPE",
+        "PWD",
+        "SHLVL",
+        "_",
+    }
 
 
 def test_forbidden_packages_cannot_be_imported_at_run_time(worker):
@@ -194,12 +219,20 @@ def make_clone(tmp_path, replace=None):
 
 def test_an_infinite_loop_costs_only_its_tests(tmp_path):
     source = reference_source("normals").replace(
-        "def fit_plane(points, weights=None):\n", "def fit_plane(points, weights=None):\n    while True:\n        pass\n")
+        "def fit_plane(points, weights=None):\n",
+        "def fit_plane(points, weights=None):\n    while True:\n        pass\n",
+    )
     clone = make_clone(tmp_path, {"pcl_course/normals.py": source})
     # 15 s, not less: the copied reference compiles its numba kernels on the
     # first call in the fresh worker (about 10 s here, no cache in the sandbox).
-    summary, _ = run_grader(str(clone), "-k", "test_fit_plane_recovers or test_estimate_normals_on_a_plane",
-                            "--call-timeout", "15", tmp_path=tmp_path)
+    summary, _ = run_grader(
+        str(clone),
+        "-k",
+        "test_fit_plane_recovers or test_estimate_normals_on_a_plane",
+        "--call-timeout",
+        "15",
+        tmp_path=tmp_path,
+    )
     scores = {t["name"]: t["score"] for t in summary["tests"]}
     assert scores["test_fit_plane_recovers_a_known_plane"] == 0
     assert scores["test_estimate_normals_on_a_plane_are_exact_and_flat"] > 0
@@ -207,14 +240,17 @@ def test_an_infinite_loop_costs_only_its_tests(tmp_path):
 
 def test_exit_at_import_and_tampering_files_change_nothing_else(tmp_path):
     marker = tmp_path / "sitecustomize-ran"
-    clone = make_clone(tmp_path, {
-        "pcl_course/metrics.py": "import sys\nsys.exit(0)\n",
-        "conftest.py": "import pytest\n@pytest.fixture(autouse=True)\ndef cheat():\n    raise SystemExit\n",
-        "pytest.ini": "[pytest]\naddopts = -p no:grading.plugin\n",
-        "sitecustomize.py": f"open({str(marker)!r}, 'w').write('ran')\n",
-        "usercustomize.py": f"open({str(marker)!r}, 'w').write('ran')\n",
-        "evil.pth": f"import os; open({str(marker)!r}, 'w').write('ran')\n",
-    })
+    clone = make_clone(
+        tmp_path,
+        {
+            "pcl_course/metrics.py": "import sys\nsys.exit(0)\n",
+            "conftest.py": "import pytest\n@pytest.fixture(autouse=True)\ndef cheat():\n    raise SystemExit\n",
+            "pytest.ini": "[pytest]\naddopts = -p no:grading.plugin\n",
+            "sitecustomize.py": f"open({str(marker)!r}, 'w').write('ran')\n",
+            "usercustomize.py": f"open({str(marker)!r}, 'w').write('ran')\n",
+            "evil.pth": f"import os; open({str(marker)!r}, 'w').write('ran')\n",
+        },
+    )
     summary, stdout = run_grader(str(clone), "-k", "test_chamfer_distance_ or test_pca_", tmp_path=tmp_path)
     chamfer = [t for t in summary["tests"] if "chamfer" in t["name"]]
     pca = [t for t in summary["tests"] if t["name"].startswith("test_pca_")]
@@ -270,9 +306,8 @@ def test_without_namespaces_the_dedicated_uid_reads_nothing_of_the_grader(tmp_pa
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
     (package / "evil.py").write_text(
-        "import os\n"
-        "def read(path):\n    return open(path).read()\n"
-        "def whoami():\n    return os.getuid()\n")
+        "import os\ndef read(path):\n    return open(path).read()\ndef whoami():\n    return os.getuid()\n"
+    )
     worker = Worker(stage(package).root, timeout=20, level=Isolation(UID, uid, "test"))
     try:
         assert worker.call("evil", "whoami", (), {}) == uid
@@ -293,16 +328,26 @@ def test_the_level_is_named_in_the_results_and_can_be_required(tmp_path):
     clone = tmp_path / "clone"
     shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
     env = {**os.environ, "PCL_SANDBOX_NAMESPACES": "0"}
-    base = [sys.executable, "-m", "grading", "grade", str(clone), "-k", "test_chamfer_distance_hand",
-            "--results", str(tmp_path / "r.json")]
+    base = [
+        sys.executable,
+        "-m",
+        "grading",
+        "grade",
+        str(clone),
+        "-k",
+        "test_chamfer_distance_hand",
+        "--results",
+        str(tmp_path / "r.json"),
+    ]
     completed = subprocess.run(base, cwd=REPO_ROOT, capture_output=True, text=True, env=env, timeout=300)
     assert completed.returncode == 0, completed.stderr
     # Here the course folder is readable by others: no wall, and it says so.
     note = json.loads((tmp_path / "r.json").read_text())["output"]
     assert note.startswith("NOT ISOLATED") and "a local check, not a mark" in note
     assert "NOT ISOLATED" in completed.stdout.splitlines()[-2] + completed.stdout.splitlines()[-1]
-    refused = subprocess.run([*base, "--require-isolation"], cwd=REPO_ROOT, capture_output=True, text=True,
-                             env=env, timeout=300)
+    refused = subprocess.run(
+        [*base, "--require-isolation"], cwd=REPO_ROOT, capture_output=True, text=True, env=env, timeout=300
+    )
     assert refused.returncode == 1
     assert refused.stderr.startswith("error: refusing to grade: the submission could not be isolated")
     assert len(refused.stderr.strip().splitlines()) == 1 and "Traceback" not in refused.stderr

@@ -31,7 +31,7 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
 
     for row in p:
         hx, hy, hz = (math.floor(v) for v in (row[:3] - lower) / voxel_size)
-        index = hx + hy * dims[0] + hz * dims[0] * dims[1]   # exact, any size
+        index = hx + hy * dims[0] + hz * dims[0] * dims[1]  # exact, any size
         container = index % n_containers
         slot = table.get(container)
         if slot is not None and slot[0] != index:

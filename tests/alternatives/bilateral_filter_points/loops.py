@@ -15,6 +15,6 @@ def bilateral_filter_points(points, normals, radius, sigma_s, sigma_r):
         t = np.sqrt((offsets**2).sum(axis=1))
         near = t <= radius
         h = offsets[near] @ n[i]
-        w = np.exp(-t[near] ** 2 / (2 * sigma_s**2) - h**2 / (2 * sigma_r**2))
+        w = np.exp(-(t[near] ** 2) / (2 * sigma_s**2) - h**2 / (2 * sigma_r**2))
         out[i] = p[i] + n[i] * (w * h).sum() / w.sum()
     return out

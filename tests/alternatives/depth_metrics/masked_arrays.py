@@ -13,5 +13,9 @@ def depth_metrics(pred, gt):
     pred_mm, gt_mm = np.ma.masked_array(pred * 1000, mask), np.ma.masked_array(gt * 1000, mask)
     pred_km, gt_km = pred_mm / 1e6, gt_mm / 1e6
     err, ierr = pred_mm - gt_mm, 1 / pred_km - 1 / gt_km
-    return {"rmse": float(np.sqrt((err**2).mean())), "mae": float(np.abs(err).mean()),
-            "irmse": float(np.sqrt((ierr**2).mean())), "imae": float(np.abs(ierr).mean())}
+    return {
+        "rmse": float(np.sqrt((err**2).mean())),
+        "mae": float(np.abs(err).mean()),
+        "irmse": float(np.sqrt((ierr**2).mean())),
+        "imae": float(np.abs(ierr).mean()),
+    }

@@ -22,7 +22,9 @@ def bilateral_filter_image(image, sigma_s, sigma_r, radius=None):
                     if not (0 <= qy < h and 0 <= qx < w):
                         continue
                     v = out[qy, qx]
-                    wt = math.exp(-((qy - y) ** 2 + (qx - x) ** 2) / (2 * sigma_s**2)) * math.exp(-((out[y, x] - v) ** 2) / (2 * sigma_r**2))
+                    wt = math.exp(-((qy - y) ** 2 + (qx - x) ** 2) / (2 * sigma_s**2)) * math.exp(
+                        -((out[y, x] - v) ** 2) / (2 * sigma_r**2)
+                    )
                     num, den = num + wt * v, den + wt
             out[y, x] = num / den
     return out

@@ -20,7 +20,9 @@ def bilateral_filter_image(image, sigma_s, sigma_r, radius=None):
             for qy in range(y - r, y + r + 1):
                 for qx in range(x - r, x + r + 1):
                     v = src[qy, qx] if 0 <= qy < h and 0 <= qx < w else 0.0
-                    wt = math.exp(-((qy - y) ** 2 + (qx - x) ** 2) / (2 * sigma_s**2)) * math.exp(-((src[y, x] - v) ** 2) / (2 * sigma_r**2))
+                    wt = math.exp(-((qy - y) ** 2 + (qx - x) ** 2) / (2 * sigma_s**2)) * math.exp(
+                        -((src[y, x] - v) ** 2) / (2 * sigma_r**2)
+                    )
                     num, den = num + wt * v, den + wt
             out[y, x] = num / den
     return out

@@ -15,6 +15,6 @@ def bilateral_filter_points(points, normals, radius, sigma_s, sigma_r):
     for i in range(len(p)):
         near = d[i] <= radius
         h = (p[near] - p[i]) @ n[i]
-        w = np.exp(-d[i, near] ** 2 / (2 * sigma_s**2)) * np.exp(-h**2 / (2 * sigma_r**2))
+        w = np.exp(-(d[i, near] ** 2) / (2 * sigma_s**2)) * np.exp(-(h**2) / (2 * sigma_r**2))
         out[i] = w @ p[near] / w.sum()
     return out

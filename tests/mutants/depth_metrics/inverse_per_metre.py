@@ -1,4 +1,4 @@
-"""Reports irmse and imae in 1\/m instead of 1\/km."""
+r"""Reports irmse and imae in 1\/m instead of 1\/km."""
 
 import numpy as np
 
@@ -12,5 +12,9 @@ def depth_metrics(pred, gt):
     valid = gt > 0
     e = (pred[valid] - gt[valid]) * 1000.0
     ie = (1.0 / pred[valid] - 1.0 / gt[valid]) * 1.0
-    return {"rmse": float(np.sqrt(np.mean(e**2))), "mae": float(np.mean(np.abs(e))),
-            "irmse": float(np.sqrt(np.mean(ie**2))), "imae": float(np.mean(np.abs(ie)))}
+    return {
+        "rmse": float(np.sqrt(np.mean(e**2))),
+        "mae": float(np.mean(np.abs(e))),
+        "irmse": float(np.sqrt(np.mean(ie**2))),
+        "imae": float(np.mean(np.abs(ie))),
+    }

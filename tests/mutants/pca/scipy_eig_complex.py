@@ -1,12 +1,11 @@
 """Uses scipy.linalg.eig, whose eigenvalues are always complex, and sorts by the real part."""
 
 import numpy as np
+import scipy.linalg
 
+from pcl_course.validation import as_points
 from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
 from solutions.pca import pca as _reference  # noqa: F401
-from pcl_course.validation import as_points
-
-import scipy.linalg
 
 
 def pca(points, correlation=False, sort=True):

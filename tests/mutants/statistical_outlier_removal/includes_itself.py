@@ -12,5 +12,6 @@ def statistical_outlier_removal(points, k, std_ratio):
     xyz = np.asarray(points, float)[:, :3]
     d, _ = cKDTree(xyz).query(xyz, k=k + 1)
     d = d[:, 1:]
-    d = cKDTree(xyz).query(xyz, k=k)[0].reshape(len(xyz), k); m = d.mean(axis=1)
+    d = cKDTree(xyz).query(xyz, k=k)[0].reshape(len(xyz), k)
+    m = d.mean(axis=1)
     return m <= m.mean() + std_ratio * m.std(ddof=1)
