@@ -4,24 +4,12 @@
 #   make lint     ruff check and ruff format --check (rules in pyproject.toml)
 #   make grade SUBMISSION=dir    grade a student's clone
 #   make bench    time the references against Open3D, scikit-learn and fpsample
-PYTHON ?= python3
-VENV   := .venv
-BIN    := $(VENV)/bin
-STAMP  := $(VENV)/.setup-done
 SUBMISSION ?=
 RESULTS ?= results/results.json
 
-.PHONY: setup lint book notebooks test grade bench requirements clean
+include scripts/setup.mk
 
-setup: $(STAMP)
-
-$(STAMP): requirements.txt pyproject.toml scripts/system-deps.sh
-	bash scripts/system-deps.sh
-	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -r requirements.txt
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-deps -e .
-	$(BIN)/python -c "import open3d, numpy, scipy, sklearn"
-	touch $@
+.PHONY: lint book notebooks test grade bench requirements clean
 
 # The execution cache keys on each page's own code only: when the package code
 # the pages run changes, drop the cache (and Sphinx's saved environment, or it

@@ -28,76 +28,28 @@ COPIED = [
     "requirements.txt",
     "requirements.in",
     ".gitignore",
+    ".ci/run",
     "benchmarks/results",
 ]  # the appendix reads the results, not the harness
 IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".ipynb_checkpoints")
 
-STUDENT_MAKEFILE = """\
-# 3D Point Cloud Processing, Lecture 1 (student repository)
-#   make book    set up, then build the book with YOUR code into _build/html
-#   make test    set up, then grade your pcl_course/ with the public tests
-PYTHON ?= python3
-VENV   := .venv
-BIN    := $(VENV)/bin
-STAMP  := $(VENV)/.setup-done
+TEMPLATES = Path(__file__).with_name("templates")  # the student repository's own files
 
-.PHONY: setup book test
 
-setup: $(STAMP)
+def _substitute(text, old, new, where, regex=False):
+    """Replace ``old`` by ``new`` in ``text``, which must hold it exactly once.
 
-$(STAMP): requirements.txt pyproject.toml scripts/system-deps.sh
-\tbash scripts/system-deps.sh
-\ttest -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-\t$(BIN)/python -m pip install --quiet --disable-pip-version-check -r requirements.txt
-\t$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-deps -e .
-\ttouch $@
-
-# Cells that need an exercise you have not done yet show "not implemented".
-book: setup
-\trm -rf _build/.jupyter_cache _build/.doctrees
-\t$(BIN)/jupyter-book build . -n --keep-going
-\t@echo "The book is in _build/html: open $(CURDIR)/_build/html/index.html"
-
-# The marks of the public tests; exits 0 whatever the score.
-test: setup
-\t$(BIN)/python -m grading grade . --results results/results.json
-"""
-
-STUDENT_README = """\
-# 3D Point Cloud Processing, Lecture 1: exercises
-
-```bash
-make book    # set up, then build the book (it runs YOUR code) into _build/html
-make test    # set up, then your marks on the public tests
-```
-
-`make setup` (run by both) installs `libusb-1.0-0`, `bubblewrap` and `chromium` with apt when
-it can, a `.venv` with the pinned requirements, and this package.
-
-## Workflow
-1. Read a chapter in `_build/html` (or the book sources in `book/`).
-2. Implement its exercises in `pcl_course/` (the stubs raise
-   `NotImplementedError`; their docstrings are the contract).
-3. Run the tests of one exercise, and see your marks:
-
-   ```bash
-   .venv/bin/python -m grading grade . -k test_pca_
-   .venv/bin/pytest tests/graded -k test_pca_      # the same tests, with tracebacks
-   ```
-
-Write your own code: Open3D, PCL and scikit-learn are for visualisation
-only, outside `pcl_course/`'s exercise modules. NumPy and SciPy (including
-`scipy.spatial.cKDTree`) are allowed. The graded run checks this.
-
-Your submission is graded with these public tests and with hidden tests of
-the same contract, in a sandbox that sees nothing but your `pcl_course/`.
-
-On every push, `.github/workflows/check.yml` grades your code with a pristine
-copy of the course's grader and writes the table to the run's summary. That
-mark, like `make test`'s, is **advisory** (you control this repository and
-its CI): the official mark is the instructor's, on Gradescope or from their
-re-grade of your submission.
-"""
+    A release never silently ships an unchanged file because its source
+    text moved on: a pattern found zero or several times stops the release.
+    """
+    if regex:
+        text, count = re.subn(old, new, text, flags=re.M)
+    else:
+        count = text.count(old)
+        text = text.replace(old, new)
+    if count != 1:
+        raise SystemExit(f"error: the release expects {old!r} exactly once in {where}, found it {count} times")
+    return text
 
 
 def _strip_solutions(markdown):
@@ -107,15 +59,19 @@ def _strip_solutions(markdown):
 
 
 def _student_config(text):
-    text = text.replace("  allow_errors: false", "  allow_errors: true")
-    text = text.replace("    nb_execution_raise_on_error: true", "    nb_execution_raise_on_error: false")
-    return text
+    # Cells of exercises a student has not done yet show "not implemented" instead of failing the build.
+    text = _substitute(text, "  allow_errors: false", "  allow_errors: true", "_config.yml")
+    return _substitute(
+        text, "    nb_execution_raise_on_error: true", "    nb_execution_raise_on_error: false", "_config.yml"
+    )
 
 
 def _student_pyproject(text):
     # The student package and the grader only: no reference, no benchmark harness.
-    text = re.sub(r"packages = \[[^\]]*\]", 'packages = ["pcl_course", "grading"]', text)
-    return re.sub(r"testpaths = \[[^\]]*\]", 'testpaths = ["tests/graded"]', text)
+    text = _substitute(
+        text, r"^packages = \[[^\]]*\]", 'packages = ["pcl_course", "grading"]', "pyproject.toml", regex=True
+    )
+    return _substitute(text, r"^testpaths = \[[^\]]*\]", 'testpaths = ["tests/graded"]', "pyproject.toml", regex=True)
 
 
 WORKFLOW_HEADER = """\
@@ -243,14 +199,14 @@ def release(out_dir, course_repository=None):
         page.write_text(_strip_solutions(page.read_text()))
     book_helper = out / "pcl_course" / "book.py"
     book_helper.write_text(
-        book_helper.read_text().replace('REFERENCE_PACKAGE = "solutions"', "REFERENCE_PACKAGE = None")
+        _substitute(
+            book_helper.read_text(), 'REFERENCE_PACKAGE = "solutions"', "REFERENCE_PACKAGE = None", "pcl_course/book.py"
+        )
     )
     (out / "_config.yml").write_text(_student_config((REPO_ROOT / "_config.yml").read_text()))
     (out / "pyproject.toml").write_text(_student_pyproject((REPO_ROOT / "pyproject.toml").read_text()))
-    (out / "Makefile").write_text(STUDENT_MAKEFILE)
-    (out / "README.md").write_text(STUDENT_README)
-    (out / ".ci").mkdir(exist_ok=True)
-    (out / ".ci" / "run").write_text('#!/usr/bin/env bash\nset -euo pipefail\ncd "$(dirname "$0")/.."\nmake test\n')
+    for name in ("Makefile", "README.md"):
+        shutil.copy2(TEMPLATES / name, out / name)
     workflow = out / ".github" / "workflows" / "check.yml"
     workflow.parent.mkdir(parents=True)
     workflow.write_text(_student_workflow(course_repository))

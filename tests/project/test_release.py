@@ -174,3 +174,21 @@ def test_the_workflow_grade_step_runs_the_pristine_grader_on_the_submission(rele
     assert metrics and all(t["status"] == "passed" for t in metrics)
     assert summary["output"].startswith("isolated: bubblewrap")
     assert "Total: " in (workspace / "results" / "marks.txt").read_text()
+
+
+def test_every_substitution_must_match_exactly_once():
+    from grading.release import _substitute
+
+    assert _substitute("a = 1\nb = 2\n", "a = 1", "a = 3", "x") == "a = 3\nb = 2\n"
+    for text in ("b = 2\n", "a = 1\na = 1\n"):
+        with pytest.raises(SystemExit, match="exactly once in x"):
+            _substitute(text, "a = 1", "a = 3", "x")
+
+
+def test_the_student_makefile_shares_the_set_up_rules(release_dir):
+    assert "include scripts/setup.mk" in (release_dir / "Makefile").read_text()
+    assert "include scripts/setup.mk" in (REPO_ROOT / "Makefile").read_text()
+    assert (release_dir / "scripts" / "setup.mk").read_bytes() == (REPO_ROOT / "scripts" / "setup.mk").read_bytes()
+    for target in ("setup", "book", "test"):
+        completed = subprocess.run(["make", "-n", target], cwd=release_dir, capture_output=True, text=True)
+        assert completed.returncode == 0, completed.stderr
