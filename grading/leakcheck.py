@@ -73,7 +73,7 @@ def function_fingerprints(source):
 VALIDATION_LINE = re.compile(r"^(\w+ = (as_points|as_array|check_\w+)\(|raise ValueError\()")
 
 
-def _code_lines(source):
+def code_lines(source):
     """Code lines, minus docstrings, comments, imports and input-validation
     boilerplate (the same in every module, and in the helpers)."""
     lines, in_docstring = [], False
@@ -95,7 +95,7 @@ def reference_index(solutions=REPO_ROOT / "solutions"):
         source = path.read_text()
         for fingerprint, name in function_fingerprints(source).items():
             fingerprints[fingerprint] = f"{path.name}:{name}"
-        lines = _code_lines(source)
+        lines = code_lines(source)
         for i in range(len(lines) - 2):
             windows[" ".join(lines[i : i + 3])] = f"{path.name} ({lines[i][:50]})"
     return fingerprints, windows

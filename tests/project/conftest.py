@@ -1,24 +1,17 @@
-import json
-import subprocess
-import sys
+"""Fixtures of the project's tests."""
 
+import zlib
+
+import numpy as np
 import pytest
+from _helpers import run_grader
 
-from grading import REPO_ROOT
 
-
-def run_grader(*args, tmp_path):
-    """Run ``python -m grading grade ARGS``; return (results summary, stdout)."""
-    results = tmp_path / "results.json"
-    completed = subprocess.run(
-        [sys.executable, "-m", "grading", "grade", *args, "--results", str(results)],
-        cwd=REPO_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=900,
-    )
-    assert completed.returncode == 0, completed.stdout + completed.stderr
-    return json.loads(results.read_text()), completed.stdout
+@pytest.fixture
+def rng(request):
+    """A random generator seeded from the test's own id: the same numbers
+    whatever the order or the xdist worker that runs the test."""
+    return np.random.default_rng(zlib.crc32(request.node.nodeid.encode()))
 
 
 @pytest.fixture(scope="session")

@@ -10,6 +10,7 @@ import pytest
 import yaml
 
 from grading import REPO_ROOT
+from grading.leakcheck import code_lines
 
 HTML = REPO_ROOT / "_build" / "html"
 
@@ -98,21 +99,6 @@ def test_no_page_source_or_notebook_download_ships():
     assert "download-source-button" not in page("book/pca")
 
 
-def _code_lines(path):
-    """The code lines of a reference module: no docstrings, comments or imports."""
-    lines, in_docstring = [], False
-    for raw in path.read_text().splitlines():
-        line = raw.strip()
-        quotes = line.count('"""') + line.count("'''")
-        if quotes:
-            in_docstring = in_docstring != (quotes == 1)
-            continue
-        if in_docstring or not line or line.startswith(("#", "import ", "from ")):
-            continue
-        lines.append(" ".join(line.split()))
-    return lines
-
-
 def test_no_reference_code_in_the_built_book():
     """No run of three consecutive code lines of solutions/ is in any built file."""
     built = "\n".join(
@@ -124,7 +110,7 @@ def test_no_reference_code_in_the_built_book():
     built = " ".join(built.split())
     leaked = []
     for path in sorted((REPO_ROOT / "solutions").glob("*.py")):
-        lines = _code_lines(path)
+        lines = code_lines(path.read_text())
         leaked += [" / ".join(lines[i : i + 3]) for i in range(len(lines) - 2) if " ".join(lines[i : i + 3]) in built]
     assert not leaked, leaked[:5]
 

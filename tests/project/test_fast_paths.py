@@ -20,17 +20,16 @@ from solutions import downsampling, filters, normals, pca
 from solutions._kernels import hash_groups, smallest_eigenpair
 from solutions._neighbors import grid_is_usable, grid_radius_count, leaf_knn
 
-RNG = np.random.default_rng(20261122)
-
 
 def _clouds():
     """Clouds that stress the fast paths: volume, surface, line, lattice ties, duplicates, far away."""
-    cube = RNG.random((3000, 3))
-    plane = np.c_[RNG.random((2000, 2)), np.zeros(2000)]
-    line = np.c_[RNG.random(500), np.zeros((500, 2))]
+    rng = np.random.default_rng(20261122)  # its own stream: the clouds do not depend on test order
+    cube = rng.random((3000, 3))
+    plane = np.c_[rng.random((2000, 2)), np.zeros(2000)]
+    line = np.c_[rng.random(500), np.zeros((500, 2))]
     lattice = np.stack(np.meshgrid(*[np.arange(7.0)] * 3), -1).reshape(-1, 3)
-    duplicates = np.repeat(RNG.random((60, 3)), 4, axis=0)
-    far = RNG.random((1500, 3)) * [3.0, 2.0, 0.1] + 1e6
+    duplicates = np.repeat(rng.random((60, 3)), 4, axis=0)
+    far = rng.random((1500, 3)) * [3.0, 2.0, 0.1] + 1e6
     return {"cube": cube, "plane": plane, "line": line, "lattice": lattice, "duplicates": duplicates, "far": far}
 
 
@@ -50,8 +49,8 @@ def test_bucket_fps_selects_the_same_indices_as_the_plain_loop(name):
         np.testing.assert_array_equal(result, expected, err_msg=f"{name}: {n_samples} from {start}")
 
 
-def test_bucket_fps_ignores_extra_columns_and_uses_small_buckets():
-    points = np.c_[RNG.random((700, 3)), RNG.random((700, 2)) * 100]
+def test_bucket_fps_ignores_extra_columns_and_uses_small_buckets(rng):
+    points = np.c_[rng.random((700, 3)), rng.random((700, 2)) * 100]
     expected = plain.farthest_point_sampling(points, 300, 5)
     np.testing.assert_array_equal(downsampling.farthest_point_sampling(points, 300, start_index=5), expected)
 
@@ -63,8 +62,8 @@ def test_bucket_fps_ignores_extra_columns_and_uses_small_buckets():
     "voxel_size, strategy",
     [(0.1, "dense table"), (0.004, "hashed int64 keys"), (1e-16, "lexicographic, beyond int64")],
 )
-def test_voxel_grid_centroids_equal_the_plain_groups(voxel_size, strategy):
-    points = np.c_[RNG.random((4000, 3)) * [1.0, 2.0, 3.0], RNG.random(4000)]
+def test_voxel_grid_centroids_equal_the_plain_groups(voxel_size, strategy, rng):
+    points = np.c_[rng.random((4000, 3)) * [1.0, 2.0, 3.0], rng.random(4000)]
     h, dims = downsampling.voxel_coordinates(points[:, :3], voxel_size)
     cells = dims[0] * dims[1] * dims[2]
     used = (
@@ -81,8 +80,8 @@ def test_voxel_grid_centroids_equal_the_plain_groups(voxel_size, strategy):
 
 
 @pytest.mark.parametrize("voxel_size", [0.1, 0.004, 1e-16])
-def test_voxel_grid_random_rows_come_one_from_each_voxel_in_order(voxel_size):
-    points = RNG.random((3000, 3))
+def test_voxel_grid_random_rows_come_one_from_each_voxel_in_order(voxel_size, rng):
+    points = rng.random((3000, 3))
     groups = plain.voxel_groups(points, voxel_size)
     result = downsampling.voxel_grid_downsample(points, voxel_size, method="random", rng=3)
     assert len(result) == len(groups)
@@ -90,13 +89,16 @@ def test_voxel_grid_random_rows_come_one_from_each_voxel_in_order(voxel_size):
         assert any(np.array_equal(row, points[m]) for m in members)
 
 
+KEYS_RNG = np.random.default_rng(20261124)  # the parameters below, built at collection
+
+
 @pytest.mark.parametrize(
     "keys",
     [
-        RNG.integers(0, 50, 5000),  # few keys, many repeats
-        RNG.integers(0, 2**62, 3000),  # all distinct
+        KEYS_RNG.integers(0, 50, 5000),  # few keys, many repeats
+        KEYS_RNG.integers(0, 2**62, 3000),  # all distinct
         np.arange(0, 2**40, 2**30),  # a stride that collides in a small table
-        np.repeat(RNG.integers(0, 10**12, 400), 5),  # runs of equal keys (the scan case)
+        np.repeat(KEYS_RNG.integers(0, 10**12, 400), 5),  # runs of equal keys (the scan case)
     ],
 )
 def test_hash_groups_numbers_keys_by_first_appearance(keys):
@@ -121,10 +123,10 @@ def test_reservoir_choice_is_uniform_within_a_voxel():
 
 @pytest.mark.parametrize("n_containers", [1, 7, 500, 10**6, 2**31 + 11, 2**62])
 @pytest.mark.parametrize("voxel_size", [0.1, 1e-16])  # linear index within int64, and beyond
-def test_hash_table_filter_emits_the_plain_groups(n_containers, voxel_size):
+def test_hash_table_filter_emits_the_plain_groups(n_containers, voxel_size, rng):
     # Scan-like order (sorted along x with noise) makes conflicts frequent.
-    points = RNG.random((2500, 4))
-    points = points[np.argsort(points[:, 0] + 0.05 * RNG.random(2500))]
+    points = rng.random((2500, 4))
+    points = points[np.argsort(points[:, 0] + 0.05 * rng.random(2500))]
     groups = plain.approximate_voxel_groups(points, voxel_size, n_containers)
     expected = np.array([points[g].mean(axis=0) for g in groups])
     result = downsampling.approximate_voxel_downsample(points, voxel_size, n_containers)
@@ -135,8 +137,8 @@ def test_hash_table_filter_emits_the_plain_groups(n_containers, voxel_size):
         assert any(np.array_equal(row, points[m]) for m in members)
 
 
-def test_hash_table_filter_with_more_containers_than_int64():
-    points = RNG.random((2000, 3))
+def test_hash_table_filter_with_more_containers_than_int64(rng):
+    points = rng.random((2000, 3))
     # More containers than cells: every voxel has its own, the exact filter.
     result = downsampling.approximate_voxel_downsample(points, 0.1, 10**20)
     np.testing.assert_allclose(result, plain.voxel_grid_centroids(points, 0.1), rtol=1e-12, atol=1e-15)
@@ -153,16 +155,17 @@ def test_hash_table_filter_with_more_containers_than_int64():
 
 
 def _symmetric_matrices():
-    rotations = np.linalg.qr(RNG.standard_normal((400, 3, 3)))[0]
+    rng = np.random.default_rng(20261123)  # its own stream: built at collection
+    rotations = np.linalg.qr(rng.standard_normal((400, 3, 3)))[0]
     spectra = {
-        "random": RNG.random((400, 3)),
-        "flat patch": np.c_[np.zeros(400), RNG.random((400, 2)) + 0.5],
-        "noisy flat": np.c_[1e-12 * RNG.random(400), RNG.random((400, 2)) + 0.5],
-        "line": np.c_[np.zeros((400, 2)), RNG.random(400) + 0.5],
+        "random": rng.random((400, 3)),
+        "flat patch": np.c_[np.zeros(400), rng.random((400, 2)) + 0.5],
+        "noisy flat": np.c_[1e-12 * rng.random(400), rng.random((400, 2)) + 0.5],
+        "line": np.c_[np.zeros((400, 2)), rng.random(400) + 0.5],
         "isotropic": np.ones((400, 3)),
-        "near-degenerate top": np.c_[RNG.random(400) * 0.1, np.ones((400, 2)) + 1e-9 * RNG.random((400, 2))],
-        "tiny": RNG.random((400, 3)) * 1e-20,
-        "huge": RNG.random((400, 3)) * 1e20,
+        "near-degenerate top": np.c_[rng.random(400) * 0.1, np.ones((400, 2)) + 1e-9 * rng.random((400, 2))],
+        "tiny": rng.random((400, 3)) * 1e-20,
+        "huge": rng.random((400, 3)) * 1e20,
     }
     for name, values in spectra.items():
         yield name, np.einsum("nij,nj,nkj->nik", rotations, values, rotations)
@@ -223,8 +226,8 @@ def test_leaf_knn_finds_the_kdtree_distances(name, k, skip_self):
         assert not np.any(indices == np.arange(len(points))[:, None])
 
 
-def test_leaf_knn_on_a_cloud_smaller_than_a_leaf():
-    points = RNG.random((5, 3))
+def test_leaf_knn_on_a_cloud_smaller_than_a_leaf(rng):
+    points = rng.random((5, 3))
     distances, _ = leaf_knn(points, 4, skip_self=True)
     np.testing.assert_allclose(distances, cKDTree(points).query(points, k=5)[0][:, 1:])
 
@@ -249,8 +252,8 @@ def test_grid_radius_count_includes_neighbours_at_exactly_the_radius():
         )
 
 
-def test_radius_outlier_removal_falls_back_to_the_tree_for_huge_grids():
-    points = np.r_[RNG.random((500, 3)) * 1e-3, [[1e6, 0.0, 0.0]]]
+def test_radius_outlier_removal_falls_back_to_the_tree_for_huge_grids(rng):
+    points = np.r_[rng.random((500, 3)) * 1e-3, [[1e6, 0.0, 0.0]]]
     assert not grid_is_usable(points, 1e-4)
     expected = plain.radius_neighbour_counts(points, 1e-4) >= 2
     np.testing.assert_array_equal(filters.radius_outlier_removal(points, 1e-4, 2), expected)
@@ -269,8 +272,8 @@ def test_statistical_outlier_removal_matches_the_plain_mask(name):
 
 
 @pytest.mark.parametrize("kernel, beta", [("gaussian", 10.0), ("laplacian", 3.0), ("polynomial", 1.0)])
-def test_kernel_pca_lanczos_matches_the_dense_solver(kernel, beta):
-    points = RNG.random((600, 3))
+def test_kernel_pca_lanczos_matches_the_dense_solver(kernel, beta, rng):
+    points = rng.random((600, 3))
     projections, eigenvalues, alphas = pca.kernel_pca(points, 3, kernel=kernel, beta=beta)
     gram = pca.kernel_matrix(points, points, kernel=kernel, beta=beta)
     ones = np.full_like(gram, 1.0 / len(gram))

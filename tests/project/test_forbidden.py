@@ -3,7 +3,7 @@
 import shutil
 
 import pytest
-from conftest import run_grader
+from _helpers import run_grader
 
 from grading import REPO_ROOT
 from grading.forbidden import scan_package, scan_source

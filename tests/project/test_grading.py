@@ -5,7 +5,7 @@ import subprocess
 import sys
 
 import pytest
-from conftest import run_grader as grade
+from _helpers import run_grader as grade
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT
 

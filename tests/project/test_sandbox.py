@@ -8,7 +8,7 @@ import textwrap
 
 import numpy as np
 import pytest
-from conftest import run_grader
+from _helpers import run_grader
 
 from grading import REPO_ROOT
 from grading.errors import SandboxError
