@@ -6,6 +6,8 @@ the xyz columns; ``h = floor((p - min) / voxel_size)`` per axis as int64;
 ``h_x + h_y * D_x + h_z * D_x * D_y``.
 """
 
+__all__ = ["voxel_grid_downsample", "approximate_voxel_downsample", "farthest_point_sampling", "normal_space_sampling"]
+
 
 def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
     """Exact voxel grid filter.
@@ -28,10 +30,23 @@ def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
         One row per occupied voxel, ordered by increasing linear voxel index
         (x fastest, then y, then z).
 
+    Raises
+    ------
+    ValueError
+        Bad ``points``; a non-positive ``voxel_size``; an unknown ``method``.
+
     Notes
     -----
     Must stay correct when ``D_x * D_y * D_z`` does not fit in int64: never
     merge two distinct voxels.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.1, 0.1, 0.0], [0.3, 0.1, 0.0], [1.2, 0.0, 0.0]])
+    >>> voxel_grid_downsample(points, voxel_size=1.0)  # two occupied voxels
+    array([[0.2, 0.1, 0. ],
+           [1.2, 0. , 0. ]])
     """
     raise NotImplementedError("voxel_grid_downsample: not implemented yet")
 
@@ -47,10 +62,30 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
     point. At the end, emit every non-empty container in increasing
     container order.
 
+    Parameters
+    ----------
+    points : array_like, shape (N, D), D >= 3
+        xyz in the first three columns; extra columns travel with their row.
+    voxel_size : float
+        Edge length of a voxel, > 0.
+    n_containers : int
+        Number of containers of the hash table, >= 1.
+    method : {"centroid", "random"}, default "centroid"
+        What a container emits: the mean of all columns of its rows, or one of
+        its rows uniformly at random.
+    rng : None, int or numpy.random.Generator
+        Random source for ``method="random"``.
+
     Returns
     -------
     downsampled : ndarray of float64, shape (M', D)
         Rows in emission order.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; a non-positive ``voxel_size``; ``n_containers`` < 1; an
+        unknown ``method``.
     """
     raise NotImplementedError("approximate_voxel_downsample: not implemented yet")
 
@@ -72,6 +107,19 @@ def farthest_point_sampling(points, n_samples, start_index=0):
         In selection order. Each next index is the point whose squared
         Euclidean (xyz) distance to its nearest already-selected point is
         largest; ties go to the lowest index. No index repeats.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; ``n_samples`` not between 0 and N; ``start_index`` not
+        between 0 and N - 1 (when ``n_samples`` > 0).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0, 0], [1, 0, 0], [5, 0, 0], [2, 0, 0]])
+    >>> farthest_point_sampling(points, 3)  # 0, then the farthest (5), then 2 (3 from 5, 2 from 0)
+    array([0, 2, 3])
     """
     raise NotImplementedError("farthest_point_sampling: not implemented yet")
 
@@ -86,9 +134,25 @@ def normal_space_sampling(normals, n_samples, n_bins=4, rng=None):
     uniformly random not-yet-taken point of that bucket, skipping exhausted
     buckets, until ``n_samples`` indices are drawn.
 
+    Parameters
+    ----------
+    normals : array_like, shape (N, 3)
+        Unit normals, one per point.
+    n_samples : int
+        Number of indices to draw, from 0 to N.
+    n_bins : int, default 4
+        Buckets per axis of the cube grid, >= 1.
+    rng : None, int or numpy.random.Generator
+        Random source of the draws within a bucket.
+
     Returns
     -------
     indices : ndarray of int64, shape (n_samples,)
         In draw order, no repeats.
+
+    Raises
+    ------
+    ValueError
+        Bad ``normals``; ``n_samples`` not between 0 and N; ``n_bins`` < 1.
     """
     raise NotImplementedError("normal_space_sampling: not implemented yet")

@@ -4,6 +4,8 @@ Use :mod:`pcl_course.neighbors` for neighbour search and
 :mod:`pcl_course.validation` for input checks. Do not call Open3D or PCL here.
 """
 
+__all__ = ["fit_plane", "estimate_normals"]
+
 
 def fit_plane(points, weights=None):
     """Weighted least-squares plane through a point set.
@@ -29,6 +31,16 @@ def fit_plane(points, weights=None):
     ValueError
         Bad ``points``; ``weights`` of the wrong shape, negative, non-finite
         or summing to zero.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> square = np.array([[0.0, 0, 2], [1, 0, 2], [0, 1, 2], [1, 1, 2]])
+    >>> centroid, normal = fit_plane(square)
+    >>> centroid
+    array([0.5, 0.5, 2. ])
+    >>> np.abs(normal)  # the plane z = 2
+    array([0., 0., 1.])
     """
     raise NotImplementedError("fit_plane: not implemented yet")
 
@@ -58,6 +70,13 @@ def estimate_normals(points, k=30, radius=None, viewpoint=None):
     curvature : ndarray of float64, shape (N,)
         Surface variation ``l_min / (l_1 + l_2 + l_3)``; 0 where the trace is
         0; NaN where the neighbourhood has fewer than 3 points.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; a non-positive ``radius``; ``k`` < 1; ``k`` larger than
+        N with ``radius=None``; both ``k`` and ``radius`` None; a ``viewpoint``
+        that is not 3 finite numbers.
 
     Notes
     -----

@@ -9,6 +9,8 @@ Run the tests of one exercise with ``pytest tests/graded -k pca`` or
 ``python -m grading grade . -k pca``.
 """
 
+__all__ = ["pca", "kernel_matrix", "kernel_pca", "kernel_pca_transform"]
+
 
 def pca(points, correlation=False, sort=True):
     """Principal component analysis of a point set.
@@ -33,7 +35,9 @@ def pca(points, correlation=False, sort=True):
         (each column minus its own mean). Note the population normalisation
         ``1 / N``, not ``1 / (N - 1)``.
     eigenvectors : ndarray of float64, shape (D, D)
-        Unit eigenvectors as **columns**:
+        Orthonormal eigenvectors as **columns**
+        (``eigenvectors.T @ eigenvectors == I``, also when eigenvalues repeat:
+        H is symmetric, so use ``np.linalg.eigh``, not ``eig``) and
         ``H @ eigenvectors[:, i] == eigenvalues[i] * eigenvectors[:, i]``.
         The sign of each eigenvector is free.
 
@@ -47,6 +51,17 @@ def pca(points, correlation=False, sort=True):
     -----
     Inputs must not be modified in place. Outputs are plain real
     ``np.ndarray`` (float64), never complex, never lists.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[-2.0, 0.0], [2.0, 0.0], [0.0, -1.0], [0.0, 1.0]])
+    >>> eigenvalues, eigenvectors = pca(points)
+    >>> eigenvalues  # the variances along x and y: 8/4 and 2/4
+    array([2. , 0.5])
+    >>> np.abs(eigenvectors)
+    array([[1., 0.],
+           [0., 1.]])
     """
     raise NotImplementedError("pca: not implemented yet")
 
@@ -77,6 +92,14 @@ def kernel_matrix(x, y, kernel="gaussian", beta=1.0, degree=2):
     ValueError
         For arrays that are not 2-D, of different widths or non-finite, an
         unknown ``kernel`` or a non-positive ``beta``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> x = np.array([[0.0, 0.0], [1.0, 0.0]])
+    >>> kernel_matrix(x, x, kernel="gaussian", beta=1.0).round(4)  # exp(-1) off the diagonal
+    array([[1.    , 0.3679],
+           [0.3679, 1.    ]])
     """
     raise NotImplementedError("kernel_matrix: not implemented yet")
 
@@ -105,6 +128,12 @@ def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
         The matching eigenvectors, scaled so that
         ``alphas[:, r] @ alphas[:, r] == 1 / eigenvalues[r]``.
         The sign of each component is free.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; ``n_components`` not between 1 and N; an unknown
+        ``kernel`` or a non-positive ``beta``.
 
     Notes
     -----
@@ -136,5 +165,11 @@ def kernel_pca_transform(new_points, points, alphas, kernel="gaussian", beta=1.0
         of ``K``), then multiplied by ``alphas``.
         ``kernel_pca_transform(points, points, alphas)`` equals the
         ``projections`` of :func:`kernel_pca`.
+
+    Raises
+    ------
+    ValueError
+        Bad ``new_points`` or ``points``, widths that differ, ``alphas`` whose
+        row count is not N; an unknown ``kernel`` or a non-positive ``beta``.
     """
     raise NotImplementedError("kernel_pca_transform: not implemented yet")

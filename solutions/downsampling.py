@@ -6,6 +6,8 @@ from pcl_course.validation import as_points, check_choice, check_integer, check_
 from solutions._kernels import axis_bounds, bucket_fps, hash_groups, hash_table_filter, reservoir_choice, voxel_keys
 from solutions._neighbors import morton_order
 
+__all__ = ["voxel_grid_downsample", "approximate_voxel_downsample", "farthest_point_sampling", "normal_space_sampling"]
+
 METHODS = ("centroid", "random")
 FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
 
@@ -76,6 +78,44 @@ def voxel_groups(xyz, voxel_size):
 
 
 def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
+    """Exact voxel grid filter.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D), D >= 3
+        xyz in the first three columns; extra columns travel with their row.
+    voxel_size : float
+        Edge length of a voxel, > 0.
+    method : {"centroid", "random"}, default "centroid"
+        ``centroid``: the mean of all columns of the voxel's rows.
+        ``random``: one of the voxel's input rows, uniformly at random.
+    rng : None, int or numpy.random.Generator
+        Random source for ``method="random"``.
+
+    Returns
+    -------
+    downsampled : ndarray of float64, shape (M, D)
+        One row per occupied voxel, ordered by increasing linear voxel index
+        (x fastest, then y, then z).
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; a non-positive ``voxel_size``; an unknown ``method``.
+
+    Notes
+    -----
+    Must stay correct when ``D_x * D_y * D_z`` does not fit in int64: never
+    merge two distinct voxels.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.1, 0.1, 0.0], [0.3, 0.1, 0.0], [1.2, 0.0, 0.0]])
+    >>> voxel_grid_downsample(points, voxel_size=1.0)  # two occupied voxels
+    array([[0.2, 0.1, 0. ],
+           [1.2, 0. , 0. ]])
+    """
     points = as_points(points)
     voxel_size = check_positive(voxel_size, "voxel_size")
     check_choice(method, "method", METHODS)
@@ -101,6 +141,41 @@ def _linear_index_modulo(h, dx, dy, m):
 
 
 def approximate_voxel_downsample(points, voxel_size, n_containers, method="centroid", rng=None):
+    """Approximate voxel grid filter with a hash table of ``n_containers``.
+
+    ``container = linear_index % n_containers``. Visit the points in input
+    order. A container holds one voxel at a time: when a point of a different
+    voxel arrives at an occupied container, first emit one row for what the
+    container holds (centroid, or a uniformly random one of its rows for
+    ``method="random"``), then start the container afresh with the new
+    point. At the end, emit every non-empty container in increasing
+    container order.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D), D >= 3
+        xyz in the first three columns; extra columns travel with their row.
+    voxel_size : float
+        Edge length of a voxel, > 0.
+    n_containers : int
+        Number of containers of the hash table, >= 1.
+    method : {"centroid", "random"}, default "centroid"
+        What a container emits: the mean of all columns of its rows, or one of
+        its rows uniformly at random.
+    rng : None, int or numpy.random.Generator
+        Random source for ``method="random"``.
+
+    Returns
+    -------
+    downsampled : ndarray of float64, shape (M', D)
+        Rows in emission order.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; a non-positive ``voxel_size``; ``n_containers`` < 1; an
+        unknown ``method``.
+    """
     points = as_points(points)
     voxel_size = check_positive(voxel_size, "voxel_size")
     n_containers = check_integer(n_containers, "n_containers", low=1)
@@ -136,6 +211,36 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
 
 
 def farthest_point_sampling(points, n_samples, start_index=0):
+    """Farthest point sampling.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D), D >= 3
+    n_samples : int
+        From 0 to N.
+    start_index : int, default 0
+        The first selected index.
+
+    Returns
+    -------
+    indices : ndarray of int64, shape (n_samples,)
+        In selection order. Each next index is the point whose squared
+        Euclidean (xyz) distance to its nearest already-selected point is
+        largest; ties go to the lowest index. No index repeats.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; ``n_samples`` not between 0 and N; ``start_index`` not
+        between 0 and N - 1 (when ``n_samples`` > 0).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> points = np.array([[0.0, 0, 0], [1, 0, 0], [5, 0, 0], [2, 0, 0]])
+    >>> farthest_point_sampling(points, 3)  # 0, then the farthest (5), then 2 (3 from 5, 2 from 0)
+    array([0, 2, 3])
+    """
     points = as_points(points)
     n = len(points)
     n_samples = check_integer(n_samples, "n_samples", low=0, high=n)
@@ -157,6 +262,36 @@ def normal_bucket_ids(normals, n_bins):
 
 
 def normal_space_sampling(normals, n_samples, n_bins=4, rng=None):
+    """Normal space sampling.
+
+    Bucket each unit normal in a cube grid over ``[-1, 1]^3``: per axis
+    ``b = clip(floor((n + 1) / 2 * n_bins), 0, n_bins - 1)``; bucket id
+    ``b_x + b_y * n_bins + b_z * n_bins ** 2``. Then draw round-robin over
+    the non-empty buckets in increasing bucket id, each draw taking a
+    uniformly random not-yet-taken point of that bucket, skipping exhausted
+    buckets, until ``n_samples`` indices are drawn.
+
+    Parameters
+    ----------
+    normals : array_like, shape (N, 3)
+        Unit normals, one per point.
+    n_samples : int
+        Number of indices to draw, from 0 to N.
+    n_bins : int, default 4
+        Buckets per axis of the cube grid, >= 1.
+    rng : None, int or numpy.random.Generator
+        Random source of the draws within a bucket.
+
+    Returns
+    -------
+    indices : ndarray of int64, shape (n_samples,)
+        In draw order, no repeats.
+
+    Raises
+    ------
+    ValueError
+        Bad ``normals``; ``n_samples`` not between 0 and N; ``n_bins`` < 1.
+    """
     normals = as_points(normals, "normals", columns=3)
     n_samples = check_integer(n_samples, "n_samples", low=0, high=len(normals))
     n_bins = check_integer(n_bins, "n_bins", low=1)
