@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from pcl_course.validation import as_array, as_points
+from pcl_course.validation import as_array, as_points, check_same_shape
 
 __all__ = [
     "read_modelnet_txt",
@@ -42,8 +42,7 @@ def write_modelnet_txt(path, points, normals):
     """Write points and normals as a ModelNet ``x,y,z,nx,ny,nz`` text file."""
     points = as_points(points, columns=3)
     normals = as_points(normals, "normals", columns=3)
-    if normals.shape != points.shape:
-        raise ValueError(f"normals must have the shape of points {points.shape}, got {normals.shape}")
+    check_same_shape(normals, "normals", points.shape, "the shape of points")
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     np.savetxt(path, np.hstack([points, normals]), fmt="%.6f", delimiter=",")
 
@@ -66,8 +65,7 @@ def write_kitti_bin(path, points, intensity):
     """Write points ``(N, 3)`` and intensity ``(N,)`` as a KITTI velodyne ``.bin``."""
     points = as_points(points, columns=3)
     intensity = as_array(intensity, "intensity", ndim=1)
-    if intensity.shape[0] != points.shape[0]:
-        raise ValueError(f"intensity must have {points.shape[0]} values, got {intensity.shape[0]}")
+    check_same_shape(intensity, "intensity", points.shape[:1], "one value per point:")
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     np.hstack([points, intensity[:, None]]).astype("<f4").tofile(path)
 

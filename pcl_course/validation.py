@@ -103,11 +103,95 @@ def _is_real_number(value):
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
+def check_scalar(value, name, low=None, high=None, include_low=True, include_high=True):
+    """Return ``value`` as a float after checking it is a finite real number within bounds.
+
+    Like scikit-learn's ``check_scalar`` for real numbers.
+
+    Parameters
+    ----------
+    value : object
+        The argument to check (a ``bool`` is refused).
+    name : str
+        The argument's name, for the error message.
+    low, high : float, optional
+        Bounds; None for no bound.
+    include_low, include_high : bool, default True
+        Whether ``value`` may equal the bound.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, if ``value`` is not a finite real number within bounds.
+
+    Examples
+    --------
+    >>> check_scalar(0.5, "std_ratio")
+    0.5
+    >>> check_scalar(0, "sigma", low=0, include_low=False)
+    Traceback (most recent call last):
+    ...
+    ValueError: sigma must be a finite number > 0, got 0
+    """
+    bounds = []
+    if low is not None:
+        bounds.append(f"{'>=' if include_low else '>'} {low:g}")
+    if high is not None:
+        bounds.append(f"{'<=' if include_high else '<'} {high:g}")
+    wanted = f"{name} must be a finite number" + (f" {' and '.join(bounds)}" if bounds else "")
+    if not _is_real_number(value) or not np.isfinite(value):
+        raise ValueError(f"{wanted}, got {value!r}")
+    too_low = low is not None and (value < low if include_low else value <= low)
+    too_high = high is not None and (value > high if include_high else value >= high)
+    if too_low or too_high:
+        raise ValueError(f"{wanted}, got {value!r}")
+    return float(value)
+
+
 def check_positive(value, name):
     """Return ``value`` as a float after checking it is finite and ``> 0``."""
     if not _is_real_number(value) or not np.isfinite(value) or value <= 0:
         raise ValueError(f"{name} must be a positive finite number, got {value!r}")
     return float(value)
+
+
+def check_same_shape(array, name, shape, what, leading=False):
+    """Raise ``ValueError`` unless ``array`` has ``shape`` (or starts with it).
+
+    Parameters
+    ----------
+    array : ndarray
+        The array to check.
+    name : str
+        Its argument name, for the message.
+    shape : tuple of int
+        The shape it must have.
+    what : str
+        What ``shape`` is, for the message (e.g. ``"the shape of points"``).
+    leading : bool, default False
+        Only compare the first ``len(shape)`` dimensions.
+
+    Returns
+    -------
+    ndarray
+        ``array`` itself.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> check_same_shape(np.zeros((4, 3)), "normals", (5, 3), "the shape of points")
+    Traceback (most recent call last):
+    ...
+    ValueError: normals must have the shape of points (5, 3), got (4, 3)
+    """
+    actual = array.shape[: len(shape)] if leading else array.shape
+    if tuple(actual) != tuple(shape) or (leading and array.ndim < len(shape)):
+        raise ValueError(f"{name} must have {what} {tuple(shape)}, got {array.shape}")
+    return array
 
 
 def check_integer(value, name, low=None, high=None):

@@ -1,12 +1,11 @@
 """Reference: outlier removal and bilateral filtering."""
 
 import math
-import numbers
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcl_course.validation import as_array, as_points, check_integer, check_positive
+from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_same_shape, check_scalar
 from solutions._neighbors import grid_is_usable, grid_radius_count, kdtree, knn_mean_distance
 
 __all__ = [
@@ -62,12 +61,6 @@ def radius_outlier_removal(points, radius, min_neighbors):
     return within - 1 >= min_neighbors
 
 
-def _check_real(value, name):
-    if not isinstance(value, numbers.Real) or isinstance(value, bool) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return float(value)
-
-
 def statistical_outlier_removal(points, k, std_ratio):
     """Keep mask of the statistical outlier filter.
 
@@ -97,7 +90,7 @@ def statistical_outlier_removal(points, k, std_ratio):
         Bad ``points``; ``k`` not between 1 and N - 1; a non-finite ``std_ratio``.
     """
     points = as_points(points)
-    std_ratio = _check_real(std_ratio, "std_ratio")
+    std_ratio = check_scalar(std_ratio, "std_ratio")
     if len(points) == 0:
         check_integer(k, "k", low=1)
         return np.zeros(0, dtype=bool)
@@ -199,8 +192,7 @@ def bilateral_filter_points(points, normals, radius, sigma_s, sigma_r):
     """
     points = as_points(points, columns=3)
     normals = as_points(normals, "normals", columns=3)
-    if normals.shape != points.shape:
-        raise ValueError(f"normals must have the shape of points {points.shape}, got {normals.shape}")
+    check_same_shape(normals, "normals", points.shape, "the shape of points")
     radius = check_positive(radius, "radius")
     sigma_s = check_positive(sigma_s, "sigma_s")
     sigma_r = check_positive(sigma_r, "sigma_r")
@@ -254,8 +246,7 @@ def joint_bilateral_upsample(sparse_depth, guide, sigma_s, sigma_r, radius):
     """
     depth = as_array(sparse_depth, "sparse_depth", ndim=2)
     guide = as_array(guide, "guide", ndim=(2, 3))
-    if guide.shape[:2] != depth.shape:
-        raise ValueError(f"guide must have the height and width of sparse_depth {depth.shape}, got {guide.shape}")
+    check_same_shape(guide, "guide", depth.shape, "the height and width of sparse_depth", leading=True)
     if guide.ndim == 2:
         guide = guide[:, :, None]
     sigma_s = check_positive(sigma_s, "sigma_s")

@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial import cKDTree
 
-from pcl_course.validation import as_array, as_points
+from pcl_course.validation import as_array, as_points, check_same_shape
 
 __all__ = ["chamfer_distance", "depth_metrics"]
 
@@ -78,8 +78,7 @@ def depth_metrics(pred, gt):
     """
     pred = as_array(pred, "pred", ndim=2)
     gt = as_array(gt, "gt", ndim=2)
-    if pred.shape != gt.shape:
-        raise ValueError(f"pred must have the shape of gt {gt.shape}, got {pred.shape}")
+    check_same_shape(pred, "pred", gt.shape, "the shape of gt")
     valid = gt > 0
     if not valid.any():
         raise ValueError("gt has no valid pixel (gt > 0)")

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from pcl_course.validation import as_array, as_points, check_integer, check_positive
+from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_same_shape
 from solutions._kernels import normals_from_neighbourhoods
 from solutions._neighbors import kdtree, knn_normals
 
@@ -48,8 +48,7 @@ def fit_plane(points, weights=None):
     if weights is None:
         weights = np.ones(len(points))
     weights = as_array(weights, "weights", ndim=1)
-    if weights.shape != (len(points),):
-        raise ValueError(f"weights must have shape ({len(points)},), got {weights.shape}")
+    check_same_shape(weights, "weights", (len(points),), "one value per point:")
     if np.any(weights < 0) or weights.sum() <= 0:
         raise ValueError("weights must be non-negative with a positive sum")
     centroid = weights @ points / weights.sum()
@@ -129,8 +128,7 @@ def estimate_normals(points, k=30, radius=None, viewpoint=None):
             k = check_integer(k, "k", low=1)
     if viewpoint is not None:
         viewpoint = as_array(viewpoint, "viewpoint", ndim=1)
-        if viewpoint.shape != (3,):
-            raise ValueError(f"viewpoint must have shape (3,), got {viewpoint.shape}")
+        check_same_shape(viewpoint, "viewpoint", (3,), "shape")
     if n == 0:
         return np.empty((0, 3)), np.empty(0)
 

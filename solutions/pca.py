@@ -5,7 +5,14 @@ from scipy.linalg import eigh
 from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 from scipy.spatial.distance import cdist, pdist, squareform
 
-from pcl_course.validation import as_array, as_points, check_choice, check_integer, check_positive
+from pcl_course.validation import (
+    as_array,
+    as_points,
+    check_choice,
+    check_integer,
+    check_positive,
+    check_same_shape,
+)
 
 __all__ = ["pca", "kernel_matrix", "kernel_pca", "kernel_pca_transform"]
 
@@ -83,8 +90,7 @@ def pca(points, correlation=False, sort=True):
 def _check_pair(x, y):
     x = as_array(x, "x", ndim=2)
     y = as_array(y, "y", ndim=2)
-    if x.shape[1] != y.shape[1]:
-        raise ValueError(f"x and y must have the same width, got {x.shape} and {y.shape}")
+    check_same_shape(y, "y", (len(y), x.shape[1]), "the width of x:")
     return x, y
 
 
@@ -277,10 +283,8 @@ def kernel_pca_transform(new_points, points, alphas, kernel="gaussian", beta=1.0
     new_points = as_points(new_points, "new_points", min_columns=1)
     points = as_points(points, min_columns=1, allow_empty=False)
     alphas = as_array(alphas, "alphas", ndim=2)
-    if alphas.shape[0] != points.shape[0]:
-        raise ValueError(f"alphas must have one row per training point ({points.shape[0]}), got {alphas.shape}")
-    if new_points.shape[1] != points.shape[1]:
-        raise ValueError(f"new_points must have the width of points ({points.shape[1]}), got {new_points.shape}")
+    check_same_shape(alphas, "alphas", points.shape[:1], "one row per training point:", leading=True)
+    check_same_shape(new_points, "new_points", (len(new_points), points.shape[1]), "the width of points:")
     gram = kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
     new_rows = kernel_matrix(new_points, points, kernel=kernel, beta=beta, degree=degree)
     column_means, grand_mean = _centring_terms(gram)

@@ -55,3 +55,10 @@ def test_the_examples_show_what_the_reference_gives(function):
     assert runner.failures == 0, f"{function}: {runner.failures} example(s) give something else"
     if "Examples\n--------" in inspect.getdoc(stub(function)):
         assert runner.tries > 0, f"{function}: its examples did not run"
+
+
+def test_the_validation_helpers_examples_run():
+    import pcl_course.validation as validation
+
+    failures, tries = doctest.testmod(validation, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert tries > 0 and failures == 0

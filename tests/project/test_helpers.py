@@ -79,3 +79,36 @@ def test_radius_neighbors_is_inclusive():
 
 def test_book_runs_the_reference_when_it_exists():
     assert book.implementation("pca").__name__ == "solutions.pca"
+
+
+# --- check_scalar and check_same_shape ----------------------------------------------
+
+
+def test_check_scalar_accepts_finite_numbers_within_bounds():
+    from pcl_course.validation import check_scalar
+
+    assert check_scalar(2, "x") == 2.0 and type(check_scalar(2, "x")) is float
+    assert check_scalar(0.0, "x", low=0) == 0.0 and check_scalar(1.0, "x", high=1.0) == 1.0
+    for value, kwargs in (
+        (0.0, {"low": 0, "include_low": False}),
+        (1.0, {"high": 1, "include_high": False}),
+        (-1.0, {"low": 0}),
+        (float("nan"), {}),
+        (float("inf"), {}),
+        (True, {}),
+        ("1", {}),
+    ):
+        with pytest.raises(ValueError, match="^x must be a finite number"):
+            check_scalar(value, "x", **kwargs)
+
+
+def test_check_same_shape_names_the_argument_and_the_shape():
+    from pcl_course.validation import check_same_shape
+
+    a = np.zeros((4, 3))
+    assert check_same_shape(a, "a", (4, 3), "the shape of b") is a
+    assert check_same_shape(np.zeros((4, 3, 2)), "g", (4, 3), "the height and width of d", leading=True) is not None
+    with pytest.raises(ValueError, match=r"^a must have the shape of b \(5, 3\), got \(4, 3\)$"):
+        check_same_shape(a, "a", (5, 3), "the shape of b")
+    with pytest.raises(ValueError, match="^g must have"):
+        check_same_shape(np.zeros(4), "g", (4, 3), "the height and width of d", leading=True)
