@@ -8,11 +8,11 @@ from solutions._neighbors import morton_order
 
 __all__ = ["voxel_grid_downsample", "approximate_voxel_downsample", "farthest_point_sampling", "normal_space_sampling"]
 
-METHODS = ("centroid", "random")
-FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
+_METHODS = ("centroid", "random")
+_FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
 
 
-def voxel_grid(xyz, voxel_size):
+def _voxel_grid(xyz, voxel_size):
     """Grid origin (per-axis minimum, shape (3,)) and grid sizes ``D`` (a tuple of Python ints).
 
     ``D`` stays Python ints so that products of it never overflow.
@@ -21,9 +21,9 @@ def voxel_grid(xyz, voxel_size):
     return lower, tuple(int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
 
 
-def voxel_coordinates(xyz, voxel_size):
+def _voxel_coordinates(xyz, voxel_size):
     """Per-axis voxel coordinates ``h`` (int64, shape (N, 3)) and grid sizes ``D`` (Python ints)."""
-    lower, dims = voxel_grid(xyz, voxel_size)
+    lower, dims = _voxel_grid(xyz, voxel_size)
     return np.floor((xyz - lower) / voxel_size).astype(np.int64), dims
 
 
@@ -43,7 +43,7 @@ def _group_sorted(h):
     return groups, int(new_voxel.sum())
 
 
-def voxel_groups(xyz, voxel_size):
+def _voxel_groups(xyz, voxel_size):
     """Voxel id of every point, numbered ``0..M-1`` in increasing linear index.
 
     Returns
@@ -61,10 +61,10 @@ def voxel_groups(xyz, voxel_size):
     keys are sorted. Beyond int64 the coordinates are sorted
     lexicographically (three keys, slowest, exact).
     """
-    lower, dims = voxel_grid(xyz, voxel_size)
+    lower, dims = _voxel_grid(xyz, voxel_size)
     n_cells = dims[0] * dims[1] * dims[2]  # Python ints: never overflows
     if n_cells > np.iinfo(np.int64).max:
-        h, _ = voxel_coordinates(xyz, voxel_size)
+        h, _ = _voxel_coordinates(xyz, voxel_size)
         return _group_sorted(h)
     linear = voxel_keys(xyz, lower, voxel_size, dims[0], dims[1])
     if n_cells <= 8 * len(xyz):
@@ -118,11 +118,11 @@ def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
     """
     points = as_points(points)
     voxel_size = check_positive(voxel_size, "voxel_size")
-    check_choice(method, "method", METHODS)
+    check_choice(method, "method", _METHODS)
     rng = check_rng(rng)
     if len(points) == 0:
         return np.empty((0, points.shape[1]))
-    groups, n_groups = voxel_groups(points[:, :3], voxel_size)
+    groups, n_groups = _voxel_groups(points[:, :3], voxel_size)
     if method == "random":
         return points[reservoir_choice(groups, n_groups, rng.random(len(points)))]
     counts = np.bincount(groups, minlength=n_groups)
@@ -179,25 +179,25 @@ def approximate_voxel_downsample(points, voxel_size, n_containers, method="centr
     points = as_points(points)
     voxel_size = check_positive(voxel_size, "voxel_size")
     n_containers = check_integer(n_containers, "n_containers", low=1)
-    check_choice(method, "method", METHODS)
+    check_choice(method, "method", _METHODS)
     rng = check_rng(rng)
     if len(points) == 0:
         return np.empty((0, points.shape[1]))
     m = n_containers
     xyz = points[:, :3]
-    lower, (dx, dy, dz) = voxel_grid(xyz, voxel_size)
+    lower, (dx, dy, dz) = _voxel_grid(xyz, voxel_size)
     n_cells = dx * dy * dz  # Python ints: exact
     if m >= n_cells:
         # Every voxel has a container of its own (its linear index), and
         # containers in increasing order are voxels in increasing linear index.
-        slots, n_slots = voxel_groups(xyz, voxel_size)
+        slots, n_slots = _voxel_groups(xyz, voxel_size)
         voxels = slots[:, None]
     else:
         if n_cells <= np.iinfo(np.int64).max:  # the linear index itself fits (and so does m)
             voxels = voxel_keys(xyz, lower, voxel_size, dx, dy)
             containers, voxels = voxels % m, voxels[:, None]
         else:
-            voxels, _ = voxel_coordinates(xyz, voxel_size)
+            voxels, _ = _voxel_coordinates(xyz, voxel_size)
             containers = _linear_index_modulo(voxels, dx, dy, m)
         if m <= 4 * len(points):
             slots, n_slots = containers, m
@@ -252,10 +252,10 @@ def farthest_point_sampling(points, n_samples, start_index=0):
     position = np.empty(n, dtype=np.int64)
     position[order] = np.arange(n)
     x, y, z = (np.ascontiguousarray(xyz[order, axis]) for axis in range(3))
-    return bucket_fps(x, y, z, order, n_samples, position[start_index], FPS_BUCKET_SIZE)
+    return bucket_fps(x, y, z, order, n_samples, position[start_index], _FPS_BUCKET_SIZE)
 
 
-def normal_bucket_ids(normals, n_bins):
+def _normal_bucket_ids(normals, n_bins):
     """Bucket id of each normal in the ``n_bins^3`` cube grid over ``[-1, 1]^3``."""
     b = np.clip(np.floor((normals + 1.0) / 2.0 * n_bins), 0, n_bins - 1).astype(np.int64)
     return b[:, 0] + b[:, 1] * n_bins + b[:, 2] * n_bins**2
@@ -296,7 +296,7 @@ def normal_space_sampling(normals, n_samples, n_bins=4, rng=None):
     n_samples = check_integer(n_samples, "n_samples", low=0, high=len(normals))
     n_bins = check_integer(n_bins, "n_bins", low=1)
     rng = check_rng(rng)
-    buckets = normal_bucket_ids(normals, n_bins)
+    buckets = _normal_bucket_ids(normals, n_bins)
     # A random order inside each bucket; a point's draw round is its rank in
     # that order. Round-robin = sort by (round, bucket id).
     shuffled = rng.permutation(len(normals))

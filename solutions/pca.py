@@ -16,8 +16,8 @@ from pcl_course.validation import (
 
 __all__ = ["pca", "kernel_matrix", "kernel_pca", "kernel_pca_transform"]
 
-KERNELS = ("linear", "polynomial", "gaussian", "laplacian")
-DISTANCES = {"gaussian": "sqeuclidean", "laplacian": "cityblock"}  # exp(-beta * distance) kernels
+_KERNELS = ("linear", "polynomial", "gaussian", "laplacian")
+_DISTANCES = {"gaussian": "sqeuclidean", "laplacian": "cityblock"}  # exp(-beta * distance) kernels
 
 
 def pca(points, correlation=False, sort=True):
@@ -130,14 +130,14 @@ def kernel_matrix(x, y, kernel="gaussian", beta=1.0, degree=2):
            [0.3679, 1.    ]])
     """
     x, y = _check_pair(x, y)
-    check_choice(kernel, "kernel", KERNELS)
+    check_choice(kernel, "kernel", _KERNELS)
     if kernel == "linear":
         return x @ y.T
     if kernel == "polynomial":
         degree = check_integer(degree, "degree", low=1)
         return (1.0 + x @ y.T) ** degree
     beta = check_positive(beta, "beta")
-    return _exp_kernel(cdist(x, y, metric=DISTANCES[kernel]), beta)
+    return _exp_kernel(cdist(x, y, metric=_DISTANCES[kernel]), beta)
 
 
 def _exp_kernel(distances, beta):
@@ -152,10 +152,10 @@ def _self_gram(points, kernel, beta, degree):
     The Gram matrix of a cloud with itself is symmetric with ones on the
     diagonal: ``pdist`` and half the exponentials, mirrored by ``squareform``.
     """
-    if kernel not in DISTANCES:
+    if kernel not in _DISTANCES:
         return kernel_matrix(points, points, kernel=kernel, beta=beta, degree=degree)
     beta = check_positive(beta, "beta")
-    gram = squareform(_exp_kernel(pdist(points, metric=DISTANCES[kernel]), beta))
+    gram = squareform(_exp_kernel(pdist(points, metric=_DISTANCES[kernel]), beta))
     np.fill_diagonal(gram, 1.0)
     return gram
 

@@ -64,7 +64,7 @@ def test_bucket_fps_ignores_extra_columns_and_uses_small_buckets(rng):
 )
 def test_voxel_grid_centroids_equal_the_plain_groups(voxel_size, strategy, rng):
     points = np.c_[rng.random((4000, 3)) * [1.0, 2.0, 3.0], rng.random(4000)]
-    h, dims = downsampling.voxel_coordinates(points[:, :3], voxel_size)
+    h, dims = downsampling._voxel_coordinates(points[:, :3], voxel_size)
     cells = dims[0] * dims[1] * dims[2]
     used = (
         "dense table"
