@@ -9,7 +9,11 @@ Grade a student's clone (its ``pcl_course/``)::
 Grade the reference solutions, or only the ``pca`` tests::
 
     python -m grading grade --reference
-    python -m grading grade . -k pca
+    python -m grading grade . --function pca
+
+An official mark (refuse to run where the submission cannot be isolated)::
+
+    python -m grading grade path/to/clone --require-isolation
 
 Grade a whole class, one submission per subdirectory, in parallel::
 
@@ -33,6 +37,7 @@ from pathlib import Path
 from grading import GRADED_FUNCTIONS, GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT, config
 
 PYTEST_EXIT_NO_TESTS = 5
+PYTEST_EXIT_USAGE = 4
 
 
 def find_package(submission):
@@ -59,6 +64,7 @@ def run_graded_tests(
     call_timeout=None,
     require_isolation=False,
     sandbox_uid=None,
+    functions=(),
 ):
     """Run the graded tests on ``impl_dir``; return pytest's exit code."""
     if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
@@ -100,6 +106,8 @@ def run_graded_tests(
         command += ["--call-timeout", str(call_timeout)]
     if keyword:
         command += ["-k", keyword]
+    for function in functions:
+        command += ["--function", function]
     if junit:
         command += ["--junitxml", str(junit)]
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
@@ -151,9 +159,13 @@ def grade(args):
         sandbox=sandbox,
         call_timeout=args.call_timeout,
         require_isolation=args.require_isolation,
+        functions=args.function,
     )
     if code == PYTEST_EXIT_NO_TESTS:
         print(f"error: no graded test matches -k {args.k!r}", file=sys.stderr)
+        return 2
+    if code == PYTEST_EXIT_USAGE:
+        print(output.strip().splitlines()[-1] if output.strip() else "error: bad arguments", file=sys.stderr)
         return 2
     if code not in (0, 1) or not results.exists():
         print(output, file=sys.stderr)
@@ -259,6 +271,13 @@ def main(argv=None):
     g.add_argument("--results", help="write the Gradescope results JSON here")
     g.add_argument("--junit", help="also write JUnit XML here")
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
+    g.add_argument(
+        "--function",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="grade only this function's tests (by their grades marker); repeatable",
+    )
     g.add_argument(
         "--call-timeout",
         type=float,

@@ -69,6 +69,13 @@ def pytest_addoption(parser):
         help="the dedicated uid that runs the submission when the grader is root",
     )
     group.addoption(
+        "--function",
+        action="append",
+        default=[],
+        metavar="NAME",
+        help="run only the graded tests of this function (their grades marker); repeatable",
+    )
+    group.addoption(
         "--require-isolation",
         action="store_true",
         help="refuse to grade unless the submission runs isolated (bubblewrap or a dedicated uid)",
@@ -152,6 +159,15 @@ def pytest_collection_modifyitems(config, items):
             "every graded test needs @pytest.mark.grades(<a function of grading.GRADED_FUNCTIONS>): "
             + ", ".join(unmarked[:5])
         )
+    wanted = config.getoption("--function")
+    if wanted:
+        unknown = sorted(set(wanted) - set(GRADED_FUNCTIONS))
+        if unknown:
+            raise pytest.UsageError(f"--function: no graded function {', '.join(unknown)}")
+        deselected = [item for item in items if _is_graded(item) and graded_function(item) not in wanted]
+        if deselected:
+            config.hook.pytest_deselected(items=deselected)
+            items[:] = [item for item in items if item not in deselected]
     for item in items:
         if _is_graded(item) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(grading_config.TEST_TIMEOUT))

@@ -70,6 +70,18 @@ def test_a_graded_test_without_its_marker_stops_the_run(tmp_path):
     assert "every graded test needs @pytest.mark.grades" in completed.stdout + completed.stderr
 
 
+def test_function_selects_by_the_grades_marker(tmp_path):
+    summary, _ = grade("--reference", "--function", "kernel_pca", tmp_path=tmp_path)
+    assert summary["tests"] and {t["tags"][0] for t in summary["tests"]} == {"kernel_pca"}
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "grade", "--reference", "--function", "no_such_function"],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert completed.returncode == 2 and "no graded function no_such_function" in completed.stderr
+
+
 def test_keyword_selects_one_exercise(tmp_path):
     summary, _ = grade("--reference", "-k", "test_pca_", tmp_path=tmp_path)
     assert summary["tests"] and all(t["name"].startswith("test_pca_") for t in summary["tests"])
@@ -94,11 +106,12 @@ def grade_one_function(module_file, tmp_path):
         "--reference",
         "--impl-module",
         f"{GRADED_FUNCTIONS[function]}={module_file}",
-        "-k",
-        f"test_{function}_",
+        "--function",
+        function,
         tmp_path=tmp_path,
     )
     assert summary["tests"], f"no test of {function} ran"
+    assert all(t["tags"] == [function] for t in summary["tests"])
     return summary
 
 
