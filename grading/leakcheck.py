@@ -73,11 +73,29 @@ def function_fingerprints(source):
 VALIDATION_LINE = re.compile(r"^(\w+ = (as_points|as_array|check_\w+)\(|raise ValueError\()")
 
 
+def _public_api_lines(source):
+    """Line numbers (1-based) of the module's ``__all__`` assignment: the
+    public names, the same in a stub and its reference by design."""
+    try:
+        tree = ast.parse(source)
+    except SyntaxError:
+        return set()
+    return {
+        number
+        for node in tree.body
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "__all__" for t in node.targets)
+        for number in range(node.lineno, node.end_lineno + 1)
+    }
+
+
 def code_lines(source):
-    """Code lines, minus docstrings, comments, imports and input-validation
-    boilerplate (the same in every module, and in the helpers)."""
+    """Code lines, minus docstrings, comments, imports, ``__all__`` and
+    input-validation boilerplate (the same in every module, and in the helpers)."""
     lines, in_docstring = [], False
-    for raw in source.splitlines():
+    public_api = _public_api_lines(source)
+    for number, raw in enumerate(source.splitlines(), start=1):
+        if number in public_api:
+            continue
         line = raw.strip()
         quotes = line.count('"""') + line.count("'''")
         if quotes:
