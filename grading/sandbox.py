@@ -502,12 +502,6 @@ def isolation(uid=None):
     return Isolation(UID, uid, why_not)
 
 
-def require_isolation(level):
-    """Raise :class:`SandboxError` unless ``level`` isolates."""
-    if not level.isolated:
-        raise SandboxError(f"refusing to grade: the submission could not be isolated ({level.reason})")
-
-
 class Worker:
     """One worker process for one staged submission; restarted after any failure.
 
