@@ -65,6 +65,7 @@ def run_graded_tests(
     require_isolation=False,
     sandbox_uid=None,
     functions=(),
+    budget=None,
 ):
     """Run the graded tests on ``impl_dir``; return pytest's exit code."""
     if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
@@ -108,6 +109,8 @@ def run_graded_tests(
         command += ["-k", keyword]
     for function in functions:
         command += ["--function", function]
+    if budget is not None:
+        command += ["--budget", str(budget)]
     if junit:
         command += ["--junitxml", str(junit)]
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
@@ -127,8 +130,12 @@ def format_report(summary, title):
         lines.append(f"{test['score']:5.1f}/{test['max_score']:<4.1f} {status} {test['name']:<{width}}{first}".rstrip())
         lines.extend(" " * (width + 17) + "  " + line for line in output[1:])
     lines += ["", f"Total: {summary['score']:g} / {summary['max_score']:g}"]
-    if summary.get("output"):
-        lines.append(summary["output"])
+    output = summary.get("output", "").splitlines()
+    per_function = [line for line in output if line.startswith("- ")]
+    notes = [line for line in output if not line.startswith("- ")]
+    if per_function:
+        lines += ["", "Per function:", *(f"  {line[2:].replace('`', '')}" for line in per_function)]
+    lines += notes  # how the submission was isolated: the last line, where it is seen
     return "\n".join(lines)
 
 
@@ -160,6 +167,7 @@ def grade(args):
         call_timeout=args.call_timeout,
         require_isolation=args.require_isolation,
         functions=args.function,
+        budget=args.budget,
     )
     if code == PYTEST_EXIT_NO_TESTS:
         print(f"error: no graded test matches -k {args.k!r}", file=sys.stderr)
@@ -271,6 +279,13 @@ def main(argv=None):
     g.add_argument("--results", help="write the Gradescope results JSON here")
     g.add_argument("--junit", help="also write JUnit XML here")
     g.add_argument("-k", help="select tests as pytest -k does (e.g. -k pca)")
+    g.add_argument(
+        "--budget",
+        type=float,
+        metavar="SECONDS",
+        help=f"wall-clock budget of the whole grading (default {config.SUBMISSION_BUDGET:g}); "
+        "tests not started by then score 0",
+    )
     g.add_argument(
         "--function",
         action="append",

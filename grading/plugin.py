@@ -25,6 +25,8 @@ Markers
 
 import json
 import os
+import tempfile
+import time
 from pathlib import Path
 
 import pytest
@@ -36,6 +38,7 @@ from grading.implementation import Implementation
 
 _IMPL_KEY = pytest.StashKey[Implementation]()
 _RESULTS_KEY = pytest.StashKey[dict]()
+_STARTED_KEY = pytest.StashKey[float]()
 
 
 def pytest_addoption(parser):
@@ -67,6 +70,14 @@ def pytest_addoption(parser):
         default=None,
         metavar="UID",
         help="the dedicated uid that runs the submission when the grader is root",
+    )
+    group.addoption(
+        "--budget",
+        type=float,
+        default=grading_config.SUBMISSION_BUDGET,
+        metavar="SECONDS",
+        help=f"wall-clock budget of the whole grading (default {grading_config.SUBMISSION_BUDGET:g}); "
+        "tests not started by then score 0",
     )
     group.addoption(
         "--function",
@@ -236,6 +247,49 @@ def _feedback(excinfo, impl):
     return f"raised {excinfo.typename}: {first}{where}{last_call}"
 
 
+NOT_RUN = "not run: grading stopped before this test"
+
+
+def _new_entry(item, number):
+    return {
+        "name": item.name,
+        "number": number,
+        "score": 0.0,
+        "max_score": _points(item),
+        "status": "failed",
+        "output": NOT_RUN,
+        "output_format": "md",
+        "tags": [graded_function(item)],
+        "visibility": "after_published" if is_hidden(item) else "visible",
+    }
+
+
+def pytest_collection_finish(session):
+    """Every graded test gets its result entry now, as not run, numbered
+    ``<function>.<test>`` in the contract's order: a run killed later still
+    leaves a complete, valid results file."""
+    results = session.config.stash[_RESULTS_KEY]
+    functions = list(GRADED_FUNCTIONS)
+    counts = {}
+    for item in session.items:
+        function = graded_function(item)
+        if _is_graded(item) and function in GRADED_FUNCTIONS:  # unmarked ones stopped the run already
+            counts[function] = counts.get(function, 0) + 1
+            results[item.nodeid] = _new_entry(item, f"{functions.index(function) + 1}.{counts[function]}")
+    session.config.stash[_STARTED_KEY] = time.monotonic()
+    _write_results(session.config)
+
+
+def _over_budget(config):
+    started = config.stash.get(_STARTED_KEY, None)
+    return started is not None and time.monotonic() - started > config.getoption("--budget")
+
+
+def pytest_runtest_setup(item):
+    if _is_graded(item) and _over_budget(item.config):
+        pytest.skip(f"not run: the submission's time budget of {item.config.getoption('--budget'):g} s ran out")
+
+
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
     outcome = yield
@@ -243,18 +297,9 @@ def pytest_runtest_makereport(item, call):
         return
     report = outcome.get_result()
     results = item.config.stash[_RESULTS_KEY]
-    entry = results.setdefault(
-        item.nodeid,
-        {
-            "name": item.name,
-            "score": 0.0,
-            "max_score": _points(item),
-            "status": "failed",
-            "output": "",
-            "tags": [graded_function(item)],
-            "visibility": "after_published" if is_hidden(item) else "visible",
-        },
-    )
+    if item.nodeid not in results:
+        results[item.nodeid] = _new_entry(item, f"0.{len(results) + 1}")
+    entry = results[item.nodeid]
     if report.when == "call" and report.passed:
         entry.update(score=entry["max_score"], status="passed", output="")
     elif report.failed:
@@ -273,19 +318,52 @@ def pytest_runtest_makereport(item, call):
         ):
             report.longrepr = message  # one line, not a traceback
     elif report.skipped and report.when != "teardown":
-        entry.update(score=0.0, status="failed", output="skipped")
+        reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else "skipped"
+        reason = reason.removeprefix("Skipped: ")
+        entry.update(score=0.0, status="failed", output=reason if reason.startswith("not run:") else "skipped")
+    if report.when == "teardown" or report.failed or report.skipped:
+        _write_results(item.config)
 
 
-def results_summary(results, isolation=None):
+def results_summary(results, isolation=None, execution_time=None):
+    """The results file's content (Gradescope's format), from the per-test entries."""
     tests = list(results.values())
+    per_function = {}
+    for test in tests:
+        score, maximum = per_function.get(test["tags"][0], (0.0, 0.0))
+        per_function[test["tags"][0]] = (score + test["score"], maximum + test["max_score"])
+    lines = [isolation] if isolation else []
+    order = list(GRADED_FUNCTIONS)
+    lines += [
+        f"- `{function}`: {score:g} / {maximum:g}"
+        for function, (score, maximum) in sorted(per_function.items(), key=lambda kv: order.index(kv[0]))
+    ]
     summary = {
         "score": sum(t["score"] for t in tests),
         "max_score": sum(t["max_score"] for t in tests),
+        "execution_time": round(execution_time) if execution_time is not None else 0,
+        "output": "\n".join(lines),
+        "stdout_visibility": "hidden",
         "tests": tests,
     }
-    if isolation is not None:
-        summary["output"] = isolation
     return summary
+
+
+def _write_results(config):
+    """Write the results file atomically (a reader never sees half of it),
+    readable by the grader's user only: a submission never reads its feedback early."""
+    path = config.getoption("--results")
+    if not path or hasattr(config, "workerinput"):
+        return
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    started = config.stash.get(_STARTED_KEY, None)
+    elapsed = time.monotonic() - started if started is not None else None
+    summary = results_summary(config.stash.get(_RESULTS_KEY, {}), isolation_note(config), elapsed)
+    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+    with os.fdopen(fd, "w") as handle:
+        handle.write(json.dumps(summary, indent=2))
+    os.replace(temporary, path)
 
 
 def pytest_unconfigure(config):
@@ -295,15 +373,7 @@ def pytest_unconfigure(config):
 
 
 def pytest_sessionfinish(session, exitstatus):
-    results = session.config.stash.get(_RESULTS_KEY, {})
-    path = session.config.getoption("--results")
-    if path and not hasattr(session.config, "workerinput"):
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        # Readable by the grader's user only: a submission never reads its feedback early.
-        fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-        with os.fdopen(fd, "w") as handle:
-            handle.write(json.dumps(results_summary(results, isolation_note(session.config)), indent=2))
+    _write_results(session.config)
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):

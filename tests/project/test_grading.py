@@ -20,10 +20,25 @@ def test_reference_gets_full_marks(reference_grading):
 
 def test_results_file_has_the_gradescope_format(tmp_path):
     summary, _ = grade("--reference", "-k", "test_pca_", tmp_path=tmp_path)
-    assert set(summary) == {"score", "max_score", "tests"}
+    assert set(summary) == {"score", "max_score", "execution_time", "output", "stdout_visibility", "tests"}
+    assert summary["stdout_visibility"] == "hidden" and summary["output"] == "- `pca`: 25 / 25"
+    assert isinstance(summary["execution_time"], int)
+    numbers = [test["number"] for test in summary["tests"]]
+    assert numbers == [f"1.{i}" for i in range(1, len(numbers) + 1)]  # pca is the contract's first function
     for test in summary["tests"]:
-        assert set(test) == {"name", "score", "max_score", "status", "output", "tags", "visibility"}
+        assert set(test) == {
+            "name",
+            "number",
+            "score",
+            "max_score",
+            "status",
+            "output",
+            "output_format",
+            "tags",
+            "visibility",
+        }
         assert test["tags"] == ["pca"] and test["visibility"] in ("visible", "after_published")
+        assert test["output_format"] == "md"
         assert test["status"] in ("passed", "failed")
         assert 0 <= test["score"] <= test["max_score"]
 
@@ -221,3 +236,58 @@ def test_a_degenerate_answer_fails_every_test_of_values(function, kind, tmp_path
         t["name"] for t in own if t["status"] == "passed" and not _is_interface_test(tests[t["name"].split("[")[0]])
     ]
     assert not passed, f"a {kind} answer of {function} passes tests of values: {passed}"
+
+
+def test_tests_past_the_time_budget_score_zero_and_say_so(tmp_path):
+    summary, _ = grade("--reference", "--function", "chamfer_distance", "--budget", "0", tmp_path=tmp_path)
+    assert summary["tests"] and summary["score"] == 0
+    for test in summary["tests"]:
+        assert test["output"] == "not run: the submission's time budget of 0 s ran out", test
+
+
+def test_a_killed_run_leaves_valid_partial_results(tmp_path):
+    import json
+    import os
+    import signal
+    import time
+
+    slow = (
+        "import time\n"
+        "from solutions.metrics import *  # noqa: F401,F403\n"
+        "from solutions.metrics import chamfer_distance as _reference\n\n\n"
+        "def chamfer_distance(a, b):\n    time.sleep(0.5)\n    return _reference(a, b)\n"
+    )
+    (tmp_path / "slow.py").write_text(slow)
+    results = tmp_path / "results.json"
+    process = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "grade",
+            "--reference",
+            "--impl-module",
+            f"metrics={tmp_path / 'slow.py'}",
+            "--function",
+            "chamfer_distance",
+            "--results",
+            str(results),
+        ],
+        cwd=REPO_ROOT,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        if results.exists() and any(t["status"] == "passed" for t in json.loads(results.read_text())["tests"]):
+            break
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    summary = json.loads(results.read_text())  # valid JSON: it was replaced atomically
+    statuses = [t["status"] for t in summary["tests"]]
+    assert "passed" in statuses
+    not_run = [t for t in summary["tests"] if t["output"] == "not run: grading stopped before this test"]
+    assert not_run and all(t["score"] == 0 for t in not_run)
+    assert summary["score"] == sum(t["score"] for t in summary["tests"])
