@@ -35,6 +35,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from grading import GRADED_FUNCTIONS, GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT, config
+from grading.plugin import points_per_function
 
 PYTEST_EXIT_NO_TESTS = 5
 PYTEST_EXIT_USAGE = 4
@@ -189,16 +190,6 @@ def grade(args):
     return 0
 
 
-def points_per_function(summary):
-    """Score and maximum per graded function, from a results summary (each test's ``tags``)."""
-    totals = {}
-    for test in summary["tests"]:
-        function = (test.get("tags") or ["other"])[0]
-        score, maximum = totals.get(function, (0.0, 0.0))
-        totals[function] = (score + test["score"], maximum + test["max_score"])
-    return totals
-
-
 def batch(args):
     root = Path(args.directory).resolve()
     # lexists: a linked submission or pcl_course is listed, then refused by staging.
@@ -242,7 +233,7 @@ def batch(args):
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         graded = list(pool.map(grade_one, submissions))
 
-    functions = [f for f in GRADED_FUNCTIONS if any(r and f in points_per_function(r) for _, r, _ in graded)]
+    functions = [f for f in GRADED_FUNCTIONS if any(r and f in points_per_function(r["tests"]) for _, r, _ in graded)]
     csv_path = Path(args.csv) if args.csv else out / "marks.csv"
     with open(csv_path, "w", newline="") as handle:
         writer = csv.writer(handle)
@@ -251,7 +242,7 @@ def batch(args):
             if summary is None:
                 writer.writerow([name, 0, "", "grading failed", *[""] * len(functions)])
                 continue
-            per_function = points_per_function(summary)
+            per_function = points_per_function(summary["tests"])
             writer.writerow(
                 [
                     name,

@@ -321,17 +321,24 @@ def pytest_runtest_makereport(item, call):
         reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else "skipped"
         reason = reason.removeprefix("Skipped: ")
         entry.update(score=0.0, status="failed", output=reason if reason.startswith("not run:") else "skipped")
-    if report.when == "teardown" or report.failed or report.skipped:
+    if report.when == "teardown":  # once per test, its verdict final
         _write_results(item.config)
+
+
+def points_per_function(tests):
+    """Score and maximum per graded function (each test's ``tags``), from result entries."""
+    totals = {}
+    for test in tests:
+        function = (test.get("tags") or ["other"])[0]
+        score, maximum = totals.get(function, (0.0, 0.0))
+        totals[function] = (score + test["score"], maximum + test["max_score"])
+    return totals
 
 
 def results_summary(results, isolation=None, execution_time=None):
     """The results file's content (Gradescope's format), from the per-test entries."""
     tests = list(results.values())
-    per_function = {}
-    for test in tests:
-        score, maximum = per_function.get(test["tags"][0], (0.0, 0.0))
-        per_function[test["tags"][0]] = (score + test["score"], maximum + test["max_score"])
+    per_function = points_per_function(tests)
     lines = [isolation] if isolation else []
     order = list(GRADED_FUNCTIONS)
     lines += [

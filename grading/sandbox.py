@@ -174,11 +174,38 @@ def _masked_entries(site):
     return sorted(masked)
 
 
+@cache
+def _environment_binds():
+    """The options that bind the interpreter, the system libraries and the
+    site-packages, with every forbidden package masked: the same for every
+    worker of this process, and slow to find (every distribution's metadata
+    is read), so found once."""
+    base = Path(sys.base_prefix).resolve()
+    site = _site_packages()
+    options = []
+    system = [("/usr/lib", "/usr/lib"), ("/usr/lib64", "/usr/lib64"), ("/usr/lib32", "/usr/lib32")]
+    system = [(source, target) for source, target in system if Path(source).is_dir()]
+    for source, target in system:
+        options += ["--ro-bind", source, target, "--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
+    options += ["--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache"]
+    mounts = [(base, SANDBOX_PYTHON_ROOT), (site, SANDBOX_SITE)]
+    for source, target in mounts:
+        options += ["--ro-bind", str(source), target]
+    # Mask the forbidden packages wherever the sandbox could import them from.
+    for source_root, target_root in [(Path(s), t) for s, t in system] + mounts:
+        for site_dir in _site_dirs(Path(source_root)):
+            for entry in _masked_entries(site_dir):
+                target = f"{target_root}/{entry.relative_to(source_root)}"
+                if entry.is_dir() and not entry.is_symlink():
+                    options += ["--tmpfs", target]
+                else:
+                    options += ["--ro-bind", "/dev/null", target]
+    return tuple(options)
+
+
 def _bubblewrap_command(staged_root, python_argv_tail):
     """The ``bwrap`` command line that runs the worker on a staged submission."""
     executable, relative = _python()
-    base = Path(sys.base_prefix).resolve()
-    site = _site_packages()
     command = [
         "bwrap",
         "--unshare-all",
@@ -191,26 +218,8 @@ def _bubblewrap_command(staged_root, python_argv_tail):
         "sandbox",
         "--cap-drop",
         "ALL",
+        *_environment_binds(),
     ]
-    system = [("/usr/lib", "/usr/lib"), ("/usr/lib64", "/usr/lib64"), ("/usr/lib32", "/usr/lib32")]
-    for source, target in system:
-        if Path(source).is_dir():
-            command += ["--ro-bind", source, target]
-            command += ["--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
-    command += ["--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache"]
-    mounts = [(base, SANDBOX_PYTHON_ROOT), (site, SANDBOX_SITE)]
-    for source, target in mounts:
-        command += ["--ro-bind", str(source), target]
-    # Mask the forbidden packages wherever the sandbox could import them from.
-    roots = [(Path(s), t) for s, t in system if Path(s).is_dir()] + mounts
-    for source_root, target_root in roots:
-        for site_dir in _site_dirs(Path(source_root)):
-            for entry in _masked_entries(site_dir):
-                target = f"{target_root}/{entry.relative_to(source_root)}"
-                if entry.is_dir() and not entry.is_symlink():
-                    command += ["--tmpfs", target]
-                else:
-                    command += ["--ro-bind", "/dev/null", target]
     command += [
         "--ro-bind",
         str(staged_root / "pcl_course"),
@@ -671,10 +680,9 @@ class Worker:
             )
             raise SandboxError(self.broken[module]) from None
         if not header.get("imported"):
-            failure = _exception(header) if header.get("phase") == "import" and "type" in header else None
             what = (
                 f"raised {header.get('type')}: {header.get('message')}"
-                if failure is not None
+                if header.get("phase") == "import" and "type" in header
                 else "the worker's answer was garbled"
             )
             where = f" (at {header['where']})" if isinstance(header.get("where"), str) and header["where"] else ""

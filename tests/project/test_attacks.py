@@ -7,7 +7,6 @@ it applies, the grader runs both as root (dropping to a dedicated uid) and
 as an unprivileged user.
 """
 
-import csv
 import json
 import os
 import shutil
@@ -19,6 +18,7 @@ import threading
 import time
 
 import pytest
+from _helpers import run_batch, run_grader
 
 from grading import REPO_ROOT
 from grading.sandbox import _make_reachable, isolation
@@ -125,27 +125,7 @@ def test_batch_never_follows_a_link_into_a_classmate(tmp_path):
     (mallory / "pcl_course" / "metrics.py").unlink()
     (mallory / "pcl_course" / "metrics.py").symlink_to("../../alice/pcl_course/metrics.py")
     (classroom / "eve").symlink_to("alice")  # a whole submission that is a link
-    completed = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "grading",
-            "batch",
-            str(classroom),
-            "--csv",
-            str(tmp_path / "marks.csv"),
-            "--jobs",
-            "2",
-            "-k",
-            "test_chamfer_distance_",
-        ],
-        cwd=REPO_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert completed.returncode == 0, completed.stdout + completed.stderr
-    rows = {row["submission"]: row for row in csv.DictReader(open(tmp_path / "marks.csv"))}
+    rows = run_batch(classroom, tmp_path / "marks.csv", "--jobs", "2", "-k", "test_chamfer_distance_")
     assert rows["alice"]["score"] == rows["alice"]["max_score"] != "0"
     assert rows["mallory"]["score"] == "0"
     assert rows["eve"]["score"] == "0"
@@ -324,27 +304,7 @@ def test_a_daemon_left_in_batch_dies_with_its_worker(tmp_path):
     make_submission(classroom / "a-mallory", {"metrics.py": DAEMON})
     make_submission(classroom / "b-bob")
     make_submission(classroom / "c-carol")
-    completed = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "grading",
-            "batch",
-            str(classroom),
-            "--csv",
-            str(tmp_path / "marks.csv"),
-            "--jobs",
-            "1",
-            "-k",
-            "test_chamfer_distance_",
-        ],
-        cwd=REPO_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert completed.returncode == 0, completed.stdout + completed.stderr
-    rows = {row["submission"]: row for row in csv.DictReader(open(tmp_path / "marks.csv"))}
+    rows = run_batch(classroom, tmp_path / "marks.csv", "--jobs", "1", "-k", "test_chamfer_distance_")
     for honest in ("b-bob", "c-carol"):
         assert rows[honest]["score"] == rows[honest]["max_score"] != "0", rows[honest]
     assert rows["a-mallory"]["score"] != rows["a-mallory"]["max_score"]
@@ -368,26 +328,10 @@ def test_a_module_that_hangs_at_import_is_detected_once(tmp_path):
 
 def test_an_input_modified_in_place_fails_as_it_does_locally(tmp_path):
     mutant = REPO_ROOT / "tests" / "mutants" / "pca" / "modifies_input.py"
-    local = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "grading",
-            "grade",
-            "--reference",
-            "--impl-module",
-            f"pca={mutant}",
-            "-k",
-            "test_pca_",
-            "--results",
-            str(tmp_path / "local.json"),
-        ],
-        cwd=REPO_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
+    (tmp_path / "local").mkdir()
+    local, _ = run_grader(
+        "--reference", "--impl-module", f"pca={mutant}", "-k", "test_pca_", tmp_path=tmp_path / "local"
     )
-    assert local.returncode == 0, local.stderr
     # The reference module with the mutant's pca defined after it (what a student would submit).
     wrong = "\n".join(line for line in mutant.read_text().splitlines() if not line.startswith("from solutions."))
     reference = (REPO_ROOT / "solutions" / "pca.py").read_text().replace("from solutions.", "from pcl_course.")
@@ -395,7 +339,6 @@ def test_an_input_modified_in_place_fails_as_it_does_locally(tmp_path):
     shutil.copy(REPO_ROOT / "solutions" / "_kernels.py", clone / "pcl_course" / "_kernels.py")
     shutil.copy(REPO_ROOT / "solutions" / "_neighbors.py", clone / "pcl_course" / "_neighbors.py")
     official, _ = grade(clone, tmp_path, "-k", "test_pca_")
-    local = json.loads((tmp_path / "local.json").read_text())
     status = {t["name"]: t["status"] for t in local["tests"]}
     assert status["test_pca_does_not_modify_its_input"] == "failed"
     assert {t["name"]: t["status"] for t in official["tests"]} == status

@@ -1,9 +1,8 @@
 """Batch mode: a folder of submissions graded in parallel, marks in a CSV."""
 
-import csv
 import shutil
-import subprocess
-import sys
+
+from _helpers import run_batch
 
 from grading import REPO_ROOT
 
@@ -27,27 +26,9 @@ def test_batch_grades_every_submission_and_writes_a_csv(tmp_path):
         .replace("np.mean(a_to_b**2) + np.mean(b_to_a**2)", "np.mean(a_to_b) + np.mean(b_to_a)")
     )  # unsquared
     (classroom / "notes.txt").write_text("not a submission")
-    completed = subprocess.run(
-        [
-            sys.executable,
-            "-m",
-            "grading",
-            "batch",
-            str(classroom),
-            "--csv",
-            str(tmp_path / "marks.csv"),
-            "--jobs",
-            "2",
-            "-k",
-            "test_chamfer_distance_ or test_depth_metrics_",
-        ],
-        cwd=REPO_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
+    rows = run_batch(
+        classroom, tmp_path / "marks.csv", "--jobs", "2", "-k", "test_chamfer_distance_ or test_depth_metrics_"
     )
-    assert completed.returncode == 0, completed.stdout + completed.stderr
-    rows = {row["submission"]: row for row in csv.DictReader(open(tmp_path / "marks.csv"))}
     assert set(rows) == {"alice", "bob", "carol"}
     assert rows["alice"]["score"] == rows["alice"]["max_score"] != "0"
     assert rows["bob"]["score"] == "0"
