@@ -149,28 +149,37 @@ def _site_dirs(root):
     return sorted(found)
 
 
+def _installed_paths(dist_info):
+    """The paths a distribution installed, relative to its site folder (first column of its RECORD)."""
+    try:
+        record = (dist_info / "RECORD").read_text(errors="replace")
+    except OSError:
+        return set()
+    paths = (line.split(",", 1)[0] for line in record.splitlines())
+    return {path for path in paths if path and not path.startswith("..")}
+
+
 def _masked_entries(site):
     """Entries of a site folder the submission must not see: the forbidden
     packages (their modules, compiled libraries, bundled ``.libs`` and
     metadata) and the editable install's files, which point back into the
     course repository."""
-    import importlib.metadata
-
     forbidden = set(config.FORBIDDEN_PACKAGES)
     masked = set()
     for entry in site.iterdir():
         stem = entry.name.split(".")[0].split("-")[0]
-        if (
-            stem in forbidden
-            or entry.name.startswith(("__editable__", "pcl_course", "pcl-course"))
-            or entry.name.endswith(".egg-link")
-        ):
+        if entry.name.startswith(("pcl_course", "pcl-course")) and entry.name.endswith(".dist-info"):
+            # This course's own editable install: every file it wrote points back into the repository.
             masked.add(entry)
-    for dist in importlib.metadata.distributions(path=[str(site)]):
-        tops = {Path(str(f)).parts[0] for f in (dist.files or []) if not str(f).startswith("..")}
-        modules = {t.split(".")[0] for t in tops}
-        if modules & forbidden or (dist.metadata["Name"] or "").lower().replace("_", "-") == "pcl-course":
-            masked.update(site / t for t in tops if (site / t).exists() or (site / t).is_symlink())
+            outside = [path for path in _installed_paths(entry) if not path.startswith(f"{entry.name}/")]
+            masked.update(site / path for path in outside if (site / path).is_file())
+        elif stem in forbidden or entry.name.startswith("__editable__") or entry.name.endswith(".egg-link"):
+            masked.add(entry)
+        elif entry.name.endswith(".dist-info"):
+            # A distribution named otherwise (scikit_learn) that installs a forbidden module (sklearn).
+            tops = {path.split("/", 1)[0] for path in _installed_paths(entry)}
+            if {top.split(".")[0] for top in tops} & forbidden:
+                masked.update(site / top for top in tops if (site / top).exists() or (site / top).is_symlink())
     return sorted(masked)
 
 
@@ -318,7 +327,7 @@ def _become_subreaper():
 
 
 def _processes():
-    """(pid, parent pid, process group, real uid) of every process."""
+    """(pid, parent pid, process group, real uid) of every living process (no zombies)."""
     found = []
     for entry in Path("/proc").glob("[0-9]*"):
         try:
@@ -326,7 +335,8 @@ def _processes():
             uid = entry.stat().st_uid
         except (OSError, IndexError):
             continue
-        found.append((int(entry.name), int(fields[1]), int(fields[2]), uid))
+        if fields[0] != "Z":
+            found.append((int(entry.name), int(fields[1]), int(fields[2]), uid))
     return found
 
 
@@ -419,7 +429,7 @@ def _bubblewrap_works(uid):
     try:
         os.chmod(staged, 0o711)
         (staged / "pcl_course").mkdir(mode=0o755)
-        (staged / WORKER.name).write_text("import sys\nsys.path.append(sys.argv[1])\nimport numpy\n")
+        (staged / WORKER.name).write_text("import sys\n")  # the worker itself imports numpy
         (staged / WORKER.name).chmod(0o644)
         probe = _spawn(
             _bubblewrap_command(staged, []),
@@ -493,6 +503,7 @@ def isolation(uid=None):
     """
     root = os.geteuid() == 0
     uid = reserve_uid(uid) if root else None
+    _become_subreaper()  # the probe's orphans come back here to be reaped
     if root:
         _make_reachable(Path(sys.base_prefix) / "lib")
         _make_reachable(_site_packages())
