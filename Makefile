@@ -4,12 +4,14 @@
 #   make lint     ruff check and ruff format --check (rules in pyproject.toml)
 #   make grade SUBMISSION=dir    grade a student's clone
 #   make bench    time the references against Open3D, scikit-learn and fpsample
+#   make gradescope   write the Gradescope autograder archive (GRADESCOPE_ZIP)
 SUBMISSION ?=
 RESULTS ?= results/results.json
+GRADESCOPE_ZIP ?= _build/gradescope/autograder.zip
 
 include scripts/setup.mk
 
-.PHONY: lint book notebooks test grade bench requirements clean
+.PHONY: lint book notebooks test grade gradescope bench requirements clean
 
 # The execution cache keys on each page's own code only: when the package code
 # the pages run changes, drop the cache (and Sphinx's saved environment, or it
@@ -44,6 +46,12 @@ test: lint book notebooks
 grade: setup
 	@test -n "$(SUBMISSION)" || { echo "usage: make grade SUBMISSION=path/to/student/clone"; exit 2; }
 	$(BIN)/python -m grading grade "$(SUBMISSION)" --results "$(RESULTS)"
+
+# The archive instructors upload to Gradescope as the assignment's autograder:
+# grader, stubs, public and hidden tests, setup.sh and run_autograder; no
+# solutions (it is scanned for them). README "Running a class".
+gradescope: setup
+	$(BIN)/python -m grading gradescope "$(GRADESCOPE_ZIP)"
 
 # Benchmarks (benchmarks/README.md): pytest-benchmark, serial (no xdist: the
 # implementations use both cores), no per-test timeout. The summary, committed,

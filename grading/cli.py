@@ -19,6 +19,10 @@ Grade a whole class, one submission per subdirectory, in parallel::
 
     python -m grading batch submissions/ --csv marks.csv
 
+Write the Gradescope autograder archive (``grading/gradescope.py``)::
+
+    python -m grading gradescope _build/gradescope/autograder.zip
+
 The exit status is 0 whenever grading ran, whatever the score; 2 for a usage
 error (no ``pcl_course/`` found, no test selected); 1 if pytest itself broke.
 """
@@ -35,7 +39,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from grading import GRADED_FUNCTIONS, GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT, config
-from grading.plugin import points_per_function
+from grading.plugin import max_score, points_per_function
 
 PYTEST_EXIT_NO_TESTS = 5
 PYTEST_EXIT_USAGE = 4
@@ -67,8 +71,9 @@ def run_graded_tests(
     sandbox_uid=None,
     functions=(),
     budget=None,
+    note=None,
 ):
-    """Run the graded tests on ``impl_dir``; return pytest's exit code."""
+    """Run the graded tests on ``impl_dir``; return pytest's exit code and its output."""
     if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
         tests = [d for d in (GRADED_TESTS, HIDDEN_TESTS) if d.is_dir()]
     command = [
@@ -112,6 +117,8 @@ def run_graded_tests(
         command += ["--function", function]
     if budget is not None:
         command += ["--budget", str(budget)]
+    if note:
+        command += ["--submission-note", note]
     if junit:
         command += ["--junitxml", str(junit)]
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
@@ -130,7 +137,7 @@ def format_report(summary, title):
         first = f"  {output[0]}" if output else ""
         lines.append(f"{test['score']:5.1f}/{test['max_score']:<4.1f} {status} {test['name']:<{width}}{first}".rstrip())
         lines.extend(" " * (width + 17) + "  " + line for line in output[1:])
-    lines += ["", f"Total: {summary['score']:g} / {summary['max_score']:g}"]
+    lines += ["", f"Total: {summary['score']:g} / {max_score(summary):g}"]
     output = summary.get("output", "").splitlines()
     per_function = [line for line in output if line.startswith("- ")]
     notes = [line for line in output if not line.startswith("- ")]
@@ -185,7 +192,7 @@ def grade(args):
     print(format_report(summary, title))
     if args.results:
         print(f"Results written to {results}")
-    if args.require_full and summary["score"] < summary["max_score"]:
+    if args.require_full and summary["score"] < max_score(summary):
         return 1
     return 0
 
@@ -247,13 +254,13 @@ def batch(args):
                 [
                     name,
                     f"{summary['score']:g}",
-                    f"{summary['max_score']:g}",
+                    f"{max_score(summary):g}",
                     "graded",
                     *[f"{per_function.get(f, (0, 0))[0]:g}" for f in functions],
                 ]
             )
     for name, summary, output in graded:
-        mark = f"{summary['score']:g} / {summary['max_score']:g}" if summary else "grading failed"
+        mark = f"{summary['score']:g} / {max_score(summary):g}" if summary else "grading failed"
         print(f"{name}: {mark}")
         if summary is None:
             print(output, file=sys.stderr)
@@ -318,7 +325,27 @@ def main(argv=None):
         help="the published student repository whose grader the students' workflow checks out "
         "(default: the repository variable PCL_COURSE_REPOSITORY)",
     )
+    z = commands.add_parser("gradescope", help="write the Gradescope autograder archive (no solutions)")
+    z.add_argument("out_zip", help="the .zip to write, e.g. _build/gradescope/autograder.zip")
+    a = commands.add_parser(
+        "autograde", help="inside a Gradescope container: grade ROOT/submission into ROOT/results/results.json"
+    )
+    a.add_argument("--root", default="/autograder", help="the autograder folder (default /autograder)")
+    a.add_argument("--budget", type=float, metavar="SECONDS", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.command == "gradescope":
+        from grading.gradescope import build_archive
+
+        leaks = build_archive(args.out_zip)
+        if leaks:
+            print("error: the archive would contain reference code:\n" + "\n".join(leaks[:20]), file=sys.stderr)
+            return 1
+        print(f"Gradescope autograder written to {args.out_zip}: upload it as the assignment's autograder")
+        return 0
+    if args.command == "autograde":
+        from grading.gradescope import autograde
+
+        return autograde(args.root, args.budget)
     if args.command == "release":
         from grading.release import release
 

@@ -87,6 +87,12 @@ def pytest_addoption(parser):
         help="run only the graded tests of this function (their grades marker); repeatable",
     )
     group.addoption(
+        "--submission-note",
+        default=None,
+        metavar="TEXT",
+        help="a first line of the results' output (e.g. which files of an upload were graded)",
+    )
+    group.addoption(
         "--require-isolation",
         action="store_true",
         help="refuse to grade unless the submission runs isolated (bubblewrap or a dedicated uid)",
@@ -335,11 +341,16 @@ def points_per_function(tests):
     return totals
 
 
-def results_summary(results, isolation=None, execution_time=None):
+def max_score(summary):
+    """The most a results file's tests can score (Gradescope's format has no top-level field for it)."""
+    return sum(test["max_score"] for test in summary["tests"])
+
+
+def results_summary(results, isolation=None, execution_time=None, note=None):
     """The results file's content (Gradescope's format), from the per-test entries."""
     tests = list(results.values())
     per_function = points_per_function(tests)
-    lines = [isolation] if isolation else []
+    lines = [line for line in (note, isolation) if line]
     order = list(GRADED_FUNCTIONS)
     lines += [
         f"- `{function}`: {score:g} / {maximum:g}"
@@ -347,7 +358,6 @@ def results_summary(results, isolation=None, execution_time=None):
     ]
     summary = {
         "score": sum(t["score"] for t in tests),
-        "max_score": sum(t["max_score"] for t in tests),
         "execution_time": round(execution_time) if execution_time is not None else 0,
         "output": "\n".join(lines),
         "stdout_visibility": "hidden",
@@ -366,7 +376,9 @@ def _write_results(config):
     path.parent.mkdir(parents=True, exist_ok=True)
     started = config.stash.get(_STARTED_KEY, None)
     elapsed = time.monotonic() - started if started is not None else None
-    summary = results_summary(config.stash.get(_RESULTS_KEY, {}), isolation_note(config), elapsed)
+    summary = results_summary(
+        config.stash.get(_RESULTS_KEY, {}), isolation_note(config), elapsed, config.getoption("--submission-note")
+    )
     fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
     with os.fdopen(fd, "w") as handle:
         handle.write(json.dumps(summary, indent=2))
@@ -394,4 +406,4 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         terminalreporter.write_line(note)
     for test in summary["tests"]:
         terminalreporter.write_line(f"{test['score']:5.1f} / {test['max_score']:<4.1f} {test['name']}")
-    terminalreporter.write_line(f"Total: {summary['score']:g} / {summary['max_score']:g}")
+    terminalreporter.write_line(f"Total: {summary['score']:g} / {max_score(summary):g}")

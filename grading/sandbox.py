@@ -19,8 +19,10 @@ machine allows (:func:`isolation`):
     No namespaces (a container that forbids them), but the grader is root:
     the worker runs as a dedicated unprivileged uid (one per ``batch`` slot)
     and the grader first checks, as that uid, that the course's tests,
-    solutions and ``.git`` cannot be read. Everything that uid left running
-    is killed after each worker.
+    solutions and ``.git`` cannot be read, and that a seccomp filter closes
+    the network (``grading/worker.py``'s ``close_network``; the worker
+    refuses to run without it). Everything that uid left running is killed
+    after each worker.
 ``none``
     Neither: the worker runs as the grader's own user, with the resource
     limits only. Grading still runs, but the result is a local check, not a
@@ -95,8 +97,8 @@ class Isolation:
             return f"isolated: bubblewrap sandbox (no network, no files of the grader's), as {who}"
         if self.level == UID:
             return (
-                f"isolated by file permissions only: dedicated uid {self.uid}, no namespaces "
-                f"({self.reason}); the network was reachable"
+                f"isolated: dedicated uid {self.uid} that cannot read the grader's files, network closed by "
+                f"a seccomp filter; no namespaces ({self.reason})"
             )
         return f"NOT ISOLATED ({self.reason}): this is a local check, not a mark"
 
@@ -483,6 +485,37 @@ def permission_wall(uid, protected):
     return None
 
 
+def network_wall(uid):
+    """None if a worker running as ``uid`` can close its network (seccomp), else why not.
+
+    Run as ``uid`` with the worker's own code (``--check-network``): the
+    socket it then fails to open is measured, not assumed.
+    """
+    folder = tempfile.mkdtemp(prefix="grading-network-")  # the course's copy is out of the uid's reach
+    os.chmod(folder, 0o755)
+    os.chmod(shutil.copy(WORKER, folder), 0o644)
+    try:
+        completed = subprocess.run(
+            [str(_python()[0]), "-I", "-S", f"{folder}/{WORKER.name}", "--check-network", str(_site_packages())],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            preexec_fn=_preexec(uid),
+            env={"PATH": "/usr/bin:/bin"},
+            cwd="/",
+        )
+        answer = json.loads(completed.stdout.strip().splitlines()[-1])
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"the network could not be closed: the check failed ({exc})"
+    except (ValueError, IndexError):
+        why = (completed.stderr.strip().splitlines() or ["no output"])[-1]
+        return f"the network could not be closed: the check failed ({why})"
+    finally:
+        kill_uid(uid)
+        shutil.rmtree(folder, ignore_errors=True)
+    return None if answer.get("closed") else f"the network could not be closed: {answer.get('why')}"
+
+
 @cache
 def isolation(uid=None):
     """The strongest isolation available here for the sandbox ``uid``.
@@ -519,6 +552,9 @@ def isolation(uid=None):
     wall = permission_wall(uid, [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()])
     if wall is not None:
         return Isolation(NONE, None, f"{why_not}; {wall}")
+    network = network_wall(uid)
+    if network is not None:
+        return Isolation(NONE, None, f"{why_not}; {network}")
     return Isolation(UID, uid, why_not)
 
 
@@ -550,7 +586,11 @@ class Worker:
     # -- process management ---------------------------------------------------
 
     def _command(self):
-        tail = [",".join(config.FORBIDDEN_PACKAGES)]
+        # Without a network namespace the seccomp filter is the only wall: required.
+        network = (
+            "optional" if self.isolation.level == BUBBLEWRAP else "required" if self.uid is not None else "optional"
+        )
+        tail = [",".join(config.FORBIDDEN_PACKAGES), network]
         if self.isolation.level == BUBBLEWRAP:
             return _bubblewrap_command(self.staged_root, tail), {}
         python = [
@@ -591,7 +631,7 @@ class Worker:
         try:
             header = self._read_frame(time.monotonic() + max(self.timeout, 60.0))
             if not header.get("ready"):
-                raise SandboxError("the worker did not start")
+                raise SandboxError(str(header.get("error") or "the worker did not start"))
         except SandboxError as exc:
             self.stop()
             raise SandboxError(f"the sandbox could not start: {exc}") from None

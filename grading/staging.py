@@ -101,6 +101,28 @@ def _read_regular_file(name, dir_fd, shown):
         os.close(fd)
 
 
+def read_regular_file(path, shown):
+    """The bytes of the file ``path``, read as staging reads a submission's files.
+
+    A loose file of a submission (an uploaded ``pca.py``): refused unless it is
+    a regular file with one link and at most
+    :data:`grading.config.STAGE_MAX_FILE_BYTES` long; ``shown`` names it in
+    the error.
+
+    Raises
+    ------
+    StagingError
+    """
+    path = Path(path)
+    parent_fd = _open_directory(str(path.parent), None, f"the folder of {shown}")
+    try:
+        data = _read_regular_file(path.name, parent_fd, shown)
+    finally:
+        os.close(parent_fd)
+    _Budget().take(len(data), shown)
+    return data
+
+
 def _copy_tree(dir_fd, target, relative, budget, files, depth):
     if depth > config.STAGE_MAX_DEPTH:
         raise StagingError(f"pcl_course/{relative} is nested more than {config.STAGE_MAX_DEPTH} folders deep")

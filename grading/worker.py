@@ -16,10 +16,20 @@ The answer also names every argument the call modified in place, with its
 new value, so that the grader can apply the same change to its own copy:
 a sandboxed call then behaves as an in-process one.
 
-Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES
-(the last a comma-separated list, from grading.config).
+Before it imports anything of the submission's, the worker closes the
+network with a seccomp filter (:func:`close_network`): every ``socket()``
+and ``io_uring_setup()`` fails with ``EACCES``. Under bubblewrap the network
+namespace has no network anyway; as a dedicated uid without namespaces (a
+Docker container) the filter is the wall, and the worker refuses to run
+without it.
+
+Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES NETWORK
+(FORBIDDEN_PACKAGES comma-separated, from grading.config; NETWORK is
+``required`` or ``optional``: whether the worker may run when the filter
+cannot be installed), or python -I -S worker.py --check-network SITE_PACKAGES.
 """
 
+import errno
 import importlib
 import io
 import json
@@ -45,6 +55,46 @@ class _ForbiddenImports:
                 "(Open3D, PCL and scikit-learn are for visualisation only)"
             )
         return None
+
+
+def close_network():
+    """Install a seccomp filter that fails every ``socket()`` (any address
+    family; ``socketpair()`` stays) and ``io_uring_setup()`` (io_uring can
+    open sockets) with ``EACCES``, for this process and all it starts.
+
+    Syscalls of another ABI (32-bit ``int 0x80``) kill the process
+    (libseccomp's default for a foreign architecture).
+
+    Returns
+    -------
+    str or None
+        None when the filter is in place; else why not.
+    """
+    try:
+        import pyseccomp as seccomp  # libseccomp's Python API, over ctypes
+
+        deny = seccomp.SyscallFilter(seccomp.ALLOW)
+        for call in ("socket", "io_uring_setup"):
+            deny.add_rule(seccomp.ERRNO(errno.EACCES), call)
+        deny.load()  # sets no_new_privs first
+    except Exception as exc:  # no libseccomp, or a kernel or container that refuses filters
+        return f"no seccomp filter ({type(exc).__name__}: {exc})"
+    return None
+
+
+def _check_network(site_packages):
+    """Measure, do not infer: after :func:`close_network`, a socket must be refused."""
+    import socket
+
+    sys.path.append(site_packages)
+    why_not = close_network()
+    if why_not is None:
+        try:
+            socket.socket(socket.AF_INET, socket.SOCK_STREAM).close()
+            why_not = "a socket could still be opened under the seccomp filter"
+        except PermissionError:
+            pass
+    print(json.dumps({"closed": why_not is None, "why": why_not}))
 
 
 def _encode(value, arrays, np):
@@ -167,13 +217,19 @@ def _call(request, protocol, np):
 
 
 def main():
-    site_packages, submission, forbidden = sys.argv[1], sys.argv[2], sys.argv[3].split(",")
+    if sys.argv[1] == "--check-network":
+        return _check_network(sys.argv[2])
+    site_packages, submission, forbidden, network = sys.argv[1], sys.argv[2], sys.argv[3].split(","), sys.argv[4]
     protocol = _Protocol(os.fdopen(os.dup(1), "wb", buffering=0))
     os.dup2(2, 1)  # the submission's prints go to stderr, not into the protocol
     sys.stdout = sys.stderr
     requests = sys.stdin.buffer
-    sys.meta_path.insert(0, _ForbiddenImports(forbidden))
     sys.path[:] = [p for p in sys.path if p and os.path.isdir(p)] + [site_packages]
+    why_not = close_network()  # before the forbidden-import finder: pyseccomp is the grader's
+    if why_not is not None and network == "required":
+        protocol.send({"ready": False, "error": f"the network could not be closed: {why_not}"})
+        return
+    sys.meta_path.insert(0, _ForbiddenImports(forbidden))
     sys.path.insert(0, submission)
     import numpy as np
 

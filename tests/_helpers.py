@@ -19,7 +19,15 @@ def run_grader(*args, tmp_path):
         timeout=900,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
-    return json.loads(results.read_text()), completed.stdout
+    return load_results(results), completed.stdout
+
+
+def load_results(path):
+    """A results file, checked against Gradescope's format, with its total as ``max_score`` for the tests."""
+    results = json.loads(path.read_text())
+    check_gradescope_results(results)
+    results["max_score"] = sum(test["max_score"] for test in results["tests"])
+    return results
 
 
 def run_batch(classroom, csv_path, *args):
@@ -36,3 +44,79 @@ def run_batch(classroom, csv_path, *args):
     assert completed.returncode == 0, completed.stdout + completed.stderr
     with open(csv_path, newline="") as handle:
         return {row["submission"]: row for row in csv.DictReader(handle)}
+
+
+def reference_source(module):
+    """A reference module as a student's file: its private helpers imported from pcl_course.
+
+    The sandbox hides solutions/, so a clone carries copies of the compiled
+    kernels the references import (:data:`REFERENCE_KERNELS`).
+    """
+    return (REPO_ROOT / "solutions" / f"{module}.py").read_text().replace("from solutions.", "from pcl_course.")
+
+
+REFERENCE_KERNELS = ("_kernels", "_neighbors")  # the references' private modules
+
+
+def reference_package(target):
+    """Write the course's ``pcl_course/`` with every exercise solved by the reference into ``target``."""
+    import shutil
+
+    from grading import EXERCISE_MODULES
+
+    shutil.copytree(REPO_ROOT / "pcl_course", target, ignore=shutil.ignore_patterns("__pycache__"))
+    for module in (*EXERCISE_MODULES, *REFERENCE_KERNELS):
+        (target / f"{module}.py").write_text(reference_source(module))
+    return target
+
+
+# Gradescope's documented fields (gradescope-autograders.readthedocs.io, "Autograder Specifications").
+GRADESCOPE_TOP = {
+    "score",
+    "execution_time",
+    "output",
+    "output_format",
+    "visibility",
+    "stdout_visibility",
+    "extra_data",
+    "tests",
+    "leaderboard",
+    "test_output_format",
+    "test_name_format",
+}
+GRADESCOPE_TEST = {
+    "score",
+    "max_score",
+    "status",
+    "name",
+    "name_format",
+    "number",
+    "output",
+    "output_format",
+    "tags",
+    "visibility",
+    "extra_data",
+}
+GRADESCOPE_VISIBILITY = {"hidden", "after_due_date", "after_published", "visible"}
+GRADESCOPE_FORMATS = {"text", "html", "simple_format", "md", "ansi"}
+
+
+def check_gradescope_results(results):
+    """Assert that ``results`` (a loaded results.json) uses Gradescope's fields only, with valid values."""
+    assert set(results) <= GRADESCOPE_TOP, set(results) - GRADESCOPE_TOP
+    assert isinstance(results.get("score", 0), (int, float))
+    assert isinstance(results["execution_time"], int) and results["execution_time"] >= 0
+    assert isinstance(results["output"], str)
+    assert results["stdout_visibility"] in GRADESCOPE_VISIBILITY
+    for test in results["tests"]:
+        assert set(test) <= GRADESCOPE_TEST, set(test) - GRADESCOPE_TEST
+        assert isinstance(test["name"], str) and test["name"]
+        assert isinstance(test["score"], (int, float)) and isinstance(test["max_score"], (int, float))
+        assert 0 <= test["score"] <= test["max_score"]
+        assert test["status"] in {"passed", "failed"}
+        assert test["output_format"] in GRADESCOPE_FORMATS
+        assert test["visibility"] in GRADESCOPE_VISIBILITY
+        assert isinstance(test["tags"], list) and all(isinstance(t, str) for t in test["tags"])
+        assert isinstance(test["number"], str)
+    numbers = [t["number"] for t in results["tests"]]
+    assert len(numbers) == len(set(numbers)), "test numbers must be unique"

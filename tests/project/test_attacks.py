@@ -18,7 +18,7 @@ import threading
 import time
 
 import pytest
-from _helpers import run_batch, run_grader
+from _helpers import load_results, run_batch, run_grader
 
 from grading import REPO_ROOT
 from grading.sandbox import _make_reachable, isolation
@@ -60,7 +60,7 @@ def grade(submission, tmp_path, *args, as_user=None):
         **kwargs,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
-    return json.loads(results.read_text()), completed.stdout + completed.stderr
+    return load_results(results), completed.stdout + completed.stderr
 
 
 def outputs(summary, prefix):

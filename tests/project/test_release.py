@@ -2,13 +2,13 @@
 not, that its grader gives the stubs 0 points without an error, and that
 the reference's code is caught if it slips in."""
 
-import json
 import shutil
 import subprocess
 import sys
 
 import pytest
 import yaml
+from _helpers import load_results
 
 from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.leakcheck import find_leaks
@@ -121,7 +121,7 @@ def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
         timeout=600,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
-    summary = json.loads((release_dir / "r.json").read_text())
+    summary = load_results(release_dir / "r.json")
     assert summary["score"] == 0 and summary["max_score"] > 0
     odd = [t for t in summary["tests"] if not t["output"].startswith("not implemented")]
     assert not odd, [(t["name"], t["output"]) for t in odd[:3]]
@@ -169,7 +169,7 @@ def test_the_workflow_grade_step_runs_the_pristine_grader_on_the_submission(rele
         env=env,
     )
     assert completed.returncode == 0, completed.stdout[-2000:] + completed.stderr[-2000:]
-    summary = json.loads((workspace / "results" / "results.json").read_text())
+    summary = load_results(workspace / "results" / "results.json")
     metrics = [t for t in summary["tests"] if t["name"].startswith(("test_chamfer_distance_", "test_depth_metrics_"))]
     assert metrics and all(t["status"] == "passed" for t in metrics)
     assert summary["output"].startswith("isolated: bubblewrap")

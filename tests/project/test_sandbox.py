@@ -8,7 +8,7 @@ import textwrap
 
 import numpy as np
 import pytest
-from _helpers import run_grader
+from _helpers import reference_source, run_grader
 
 from grading import REPO_ROOT
 from grading.errors import SandboxError
@@ -195,15 +195,6 @@ def test_the_reference_and_the_tests_are_not_readable(worker):
         worker.call("evil", "read_reference", (), {})
     with pytest.raises((FileNotFoundError, PermissionError)):  # the course folder does not exist there
         worker.call("evil", "list_tests", (), {})
-
-
-def reference_source(module):
-    """A reference module as a student's file: its private helpers imported from pcl_course.
-
-    The sandbox hides solutions/, so a clone carries copies of the compiled
-    kernels the references import.
-    """
-    return (REPO_ROOT / "solutions" / f"{module}.py").read_text().replace("from solutions.", "from pcl_course.")
 
 
 def make_clone(tmp_path, replace=None):

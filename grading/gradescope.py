@@ -1,0 +1,319 @@
+"""Gradescope: the autograder archive, and what runs in it for each submission.
+
+``python -m grading gradescope OUT.zip`` writes the archive an instructor
+uploads (:func:`build_archive`). Gradescope unpacks it into
+``/autograder/source``, runs its ``setup.sh`` once as root to build the
+image, then, for every submission in a fresh container, runs
+``run_autograder``, which calls ``python -m grading autograde``
+(:func:`autograde`):
+
+1. find the student's code in ``/autograder/submission`` (:func:`locate`):
+   the whole repository, its ``pcl_course/`` folder, or loose module files;
+2. lay it over a pristine copy of the course's ``pcl_course/`` (stubs and
+   helpers), so that a module the student did not upload is the stub;
+3. grade that with the trusted grader, ``--require-isolation``: the
+   submission runs as a dedicated uid that cannot read the course folder
+   (``chmod 700`` by ``setup.sh``), in bubblewrap where the image allows it;
+4. the results go to ``/autograder/results/results.json``, rewritten after
+   every test, with a first line saying what was found and what was missing.
+
+The archive holds the grader, the stubs and helpers, the public and hidden
+tests and the pinned requirements; never ``solutions/``. It is scanned for
+the reference's code (:mod:`grading.leakcheck`) before it is written.
+"""
+
+import json
+import os
+import shutil
+import stat
+import tempfile
+import time
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from grading import EXERCISE_MODULES, REPO_ROOT
+from grading.errors import StagingError
+from grading.leakcheck import find_leaks
+from grading.release import IGNORED, _substitute
+from grading.staging import read_regular_file, stage
+
+TEMPLATES = Path(__file__).with_name("templates") / "gradescope"
+COURSE = "course"  # the course copy's folder inside /autograder/source
+# What the grader needs, from this repository; solutions/ never.
+COURSE_FILES = ("pcl_course", "grading", "tests/graded", "tests/hidden", "requirements.txt")
+SCRIPTS = ("setup.sh", "run_autograder")
+ZIP_DATE = (2026, 1, 1, 0, 0, 0)  # every entry's time: the same course gives the same archive
+
+# Where a submission's code may be, below /autograder/submission.
+SEARCH_DEPTH = 3
+SKIPPED_FOLDERS = {".git", ".venv", "venv", "node_modules", "__MACOSX", "_build", "__pycache__", ".github"}
+
+
+# -- the archive ------------------------------------------------------------------
+
+
+def _course_copy(into):
+    """The course, as the archive holds it: grader, stubs, helpers, tests."""
+    for name in COURSE_FILES:
+        source = REPO_ROOT / name
+        target = into / name
+        if source.is_dir():
+            shutil.copytree(source, target, ignore=IGNORED)
+        else:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(source, target)
+    book_helper = into / "pcl_course" / "book.py"  # the book's link to the reference: cut, as in the release
+    book_helper.write_text(
+        _substitute(
+            book_helper.read_text(), 'REFERENCE_PACKAGE = "solutions"', "REFERENCE_PACKAGE = None", "pcl_course/book.py"
+        )
+    )
+
+
+def _zip_entry(path, name):
+    info = zipfile.ZipInfo(name, date_time=ZIP_DATE)
+    executable = name in SCRIPTS
+    info.external_attr = ((0o755 if executable else 0o644) | stat.S_IFREG) << 16
+    info.compress_type = zipfile.ZIP_DEFLATED
+    return info
+
+
+def build_archive(out_zip):
+    """Write the Gradescope autograder archive to ``out_zip``.
+
+    Parameters
+    ----------
+    out_zip : path
+        The ``.zip`` to write (its folder is created).
+
+    Returns
+    -------
+    list of str
+        Places in the archive holding the reference's code; the archive is
+        written only when this is empty.
+    """
+    out_zip = Path(out_zip).resolve()
+    with tempfile.TemporaryDirectory(prefix="gradescope-") as work:
+        root = Path(work)
+        _course_copy(root / COURSE)
+        for name in SCRIPTS:
+            shutil.copy2(TEMPLATES / name, root / name)
+        leaks = find_leaks(root)
+        if leaks:
+            return leaks
+        out_zip.parent.mkdir(parents=True, exist_ok=True)
+        temporary = out_zip.with_name(f".{out_zip.name}.part")
+        with zipfile.ZipFile(temporary, "w") as archive:
+            for path in sorted(p for p in root.rglob("*") if p.is_file()):
+                name = path.relative_to(root).as_posix()
+                archive.writestr(_zip_entry(path, name), path.read_bytes())
+        os.replace(temporary, out_zip)
+    return []
+
+
+# -- finding a submission's code -----------------------------------------------------
+
+
+@dataclass
+class Located:
+    """Where a submission's code is.
+
+    Attributes
+    ----------
+    package : Path or None
+        Its ``pcl_course/`` folder, when it has one (the whole repository or
+        the folder was uploaded).
+    modules : dict
+        Otherwise: exercise module name -> the loose file (``pca.py``, ...).
+    ignored : list of str
+        Loose ``.py`` files that are not exercise modules (never graded).
+    """
+
+    package: Path = None
+    modules: dict = field(default_factory=dict)
+    ignored: list = field(default_factory=list)
+
+
+def _walk(root):
+    """``(depth, folder, entries)`` below ``root``, breadth first, never through a link."""
+    queue = [(0, Path(root))]
+    while queue:
+        depth, folder = queue.pop(0)
+        try:
+            entries = sorted(os.scandir(folder), key=lambda e: e.name)
+        except OSError:
+            continue
+        yield depth, folder, entries
+        if depth < SEARCH_DEPTH:
+            queue += [
+                (depth + 1, Path(e.path))
+                for e in entries
+                if e.is_dir(follow_symlinks=False) and e.name not in SKIPPED_FOLDERS and not e.name.startswith(".")
+            ]
+
+
+def locate(submission):
+    """Find the code in a Gradescope submission folder.
+
+    The shallowest folder named ``pcl_course`` wins (an upload of the whole
+    repository, or of the folder). Without one, the exercise modules are
+    looked for as loose files (an upload of ``pca.py``, ``normals.py``, ...),
+    the shallowest of each name.
+
+    Raises
+    ------
+    StagingError
+        When two candidates are equally shallow: the grader does not guess.
+    """
+    packages, loose = [], {}
+    for depth, _folder, entries in _walk(submission):
+        for entry in entries:
+            if entry.name == "pcl_course" and (entry.is_dir(follow_symlinks=False) or entry.is_symlink()):
+                packages.append((depth, Path(entry.path)))
+            elif entry.name.endswith(".py") and entry.name[:-3] in EXERCISE_MODULES:
+                loose.setdefault(entry.name[:-3], []).append((depth, Path(entry.path)))
+    if packages:
+        shallowest = [path for depth, path in packages if depth == packages[0][0]]
+        if len(shallowest) > 1:
+            shown = ", ".join(str(p.relative_to(submission)) for p in shallowest)
+            raise StagingError(f"the submission holds several pcl_course/ folders ({shown}): upload one")
+        return Located(package=shallowest[0])
+    located = Located()
+    for name, places in sorted(loose.items()):
+        places.sort(key=lambda place: place[0])
+        tied = [path for depth, path in places if depth == places[0][0]]
+        if len(tied) > 1:
+            shown = ", ".join(str(p.relative_to(submission)) for p in tied)
+            raise StagingError(f"the submission holds several {name}.py ({shown}): upload one")
+        located.modules[name] = tied[0]
+    if located.modules:
+        folder = next(iter(located.modules.values())).parent
+        located.ignored = sorted(
+            e.name for e in os.scandir(folder) if e.name.endswith(".py") and e.name[:-3] not in EXERCISE_MODULES
+        )
+    return located
+
+
+def assemble(submission, into):
+    """Lay the submission's code over a pristine ``pcl_course/`` in ``into``.
+
+    Every file of the submission is read as staging reads it (regular files
+    only, no link followed, with caps): a link, a device or compiled code
+    refuses the whole submission.
+
+    Returns
+    -------
+    package : Path
+        ``into / "pcl_course"``, ready to grade.
+    note : str
+        One Markdown line: what was found, from where, and what was missing.
+
+    Raises
+    ------
+    StagingError
+        When nothing gradable was found, or the submission cannot be staged.
+    """
+    submission = Path(submission)
+    located = locate(submission)
+    package = Path(into) / "pcl_course"
+    shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=IGNORED)
+    found = []
+    if located.package is not None:
+        staged = stage(located.package, Path(into) / "staged")
+        for relative in staged.files:
+            target = package / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(staged.package / relative, target)
+        shutil.rmtree(staged.root)
+        where = located.package.relative_to(submission).as_posix() + "/"
+        found = [m for m in EXERCISE_MODULES if f"{m}.py" in staged.files or f"{m}/__init__.py" in staged.files]
+    elif located.modules:
+        for name, path in located.modules.items():
+            (package / f"{name}.py").write_bytes(read_regular_file(path, f"{path.relative_to(submission)}"))
+        where = sorted({p.parent.relative_to(submission).as_posix() for p in located.modules.values()})
+        where = "the uploaded files" if where == ["."] else ", ".join(f"{w}/" for w in where)
+        found = list(located.modules)
+    else:
+        expected = ", ".join(f"{m}.py" for m in EXERCISE_MODULES)
+        raise StagingError(
+            f"no pcl_course/ folder and none of {expected} in the submission: "
+            "upload your repository, its pcl_course/ folder, or those files"
+        )
+    missing = [m for m in EXERCISE_MODULES if m not in found]
+    note = f"Graded from {where}: " + ", ".join(f"`{m}.py`" for m in found) + "."
+    if missing:
+        note += " Missing (graded as the course's stub, 0 points): " + ", ".join(f"`{m}.py`" for m in missing) + "."
+    if located.ignored:
+        note += " Not graded (not exercise modules): " + ", ".join(f"`{n}`" for n in located.ignored) + "."
+    return package, note
+
+
+# -- one submission, in the container -------------------------------------------------
+
+
+def _failure_results(message, started):
+    return {
+        "score": 0.0,
+        "execution_time": round(time.monotonic() - started),
+        "output": message,
+        "stdout_visibility": "hidden",
+        "tests": [],
+    }
+
+
+def _write_json(path, content):
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
+    with os.fdopen(fd, "w") as handle:
+        json.dump(content, handle, indent=2)
+    os.replace(temporary, path)
+
+
+def autograde(root="/autograder", budget=None):
+    """Grade ``root/submission`` into ``root/results/results.json``; return the exit status.
+
+    A submission that cannot be graded (nothing found, refused by staging,
+    or a container where it cannot be isolated) still gets a results file,
+    with score 0 and one line that says why.
+    """
+    from grading.cli import run_graded_tests  # the cli imports this module's archive builder
+    from grading.sandbox import isolation
+
+    started = time.monotonic()
+    root = Path(root)
+    results = root / "results" / "results.json"
+    results.parent.mkdir(parents=True, exist_ok=True)
+    os.chmod(results.parent, 0o755)  # written by the grader only: never by the submission's uid
+    level = isolation()
+    if not level.isolated:
+        message = (
+            f"The autograder could not isolate submissions here ({level.reason}). "
+            "This is a problem of the autograder's set-up, not of your code: tell your instructor."
+        )
+        _write_json(results, _failure_results(message, started))
+        print(message)
+        return 1
+    work = Path(tempfile.mkdtemp(prefix="gradescope-submission-"))
+    try:
+        try:
+            package, note = assemble(root / "submission", work)
+        except StagingError as exc:
+            message = f"submission refused: {exc}"
+            _write_json(results, _failure_results(message, started))
+            print(message)
+            return 0
+        print(note)
+        remaining = None if budget is None else max(0.0, budget - (time.monotonic() - started))
+        code, output = run_graded_tests(
+            package, results, sandbox=True, require_isolation=True, note=note, budget=remaining
+        )
+        print(output)
+        if code not in (0, 1) or not results.exists():
+            message = f"The grading run broke (pytest exit code {code}): tell your instructor."
+            _write_json(results, _failure_results(message, started))
+            print(message)
+            return 1
+        return 0
+    finally:
+        shutil.rmtree(work, ignore_errors=True)

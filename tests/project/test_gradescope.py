@@ -1,0 +1,240 @@
+"""The Gradescope autograder archive, end to end, in a mock ``/autograder``.
+
+The archive is built by ``python -m grading gradescope``, unpacked into a
+temporary root laid out as Gradescope lays out ``/autograder``
+(``source/``, ``submission/``, ``results/``), set up by its own
+``setup.sh`` (its documented fast path: ``PCL_SETUP_SKIP_APT=1`` and this
+project's venv as ``PCL_GRADER_VENV``), and run by its own
+``run_autograder`` on real uploads: the reference as a whole repository,
+the stubs as a ``pcl_course/`` folder, a wrong module as a loose file, and
+hostile submissions, with and without namespaces (Gradescope's containers
+usually have none).
+"""
+
+import json
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+import zipfile
+from pathlib import Path
+
+import pytest
+from _helpers import load_results, reference_package, reference_source
+
+from grading import EXERCISE_MODULES, GRADED_FUNCTIONS, REPO_ROOT
+from grading.leakcheck import find_leaks
+from grading.sandbox import _make_reachable
+
+needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="the dedicated-uid wall needs a root grader")
+
+
+@pytest.fixture(scope="module")
+def archive(tmp_path_factory):
+    out = tmp_path_factory.mktemp("archive") / "autograder.zip"
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "gradescope", str(out)], cwd=REPO_ROOT, capture_output=True, text=True
+    )
+    assert completed.returncode == 0, completed.stderr
+    return out
+
+
+def autograder_root(archive, root):
+    """Unpack ``archive`` as Gradescope does and run its ``setup.sh``; return the root."""
+    for name in ("source", "submission", "results"):
+        (root / name).mkdir(parents=True)
+    with zipfile.ZipFile(archive) as unpacked:
+        unpacked.extractall(root / "source")
+        for info in unpacked.infolist():  # extractall drops the modes Gradescope keeps
+            os.chmod(root / "source" / info.filename, (info.external_attr >> 16) & 0o777)
+    env = dict(os.environ, PCL_SETUP_SKIP_APT="1", PCL_GRADER_VENV=sys.prefix)
+    completed = subprocess.run(
+        ["bash", str(root / "source" / "setup.sh")], env=env, capture_output=True, text=True, timeout=600
+    )
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    return root
+
+
+def run_autograder(root, namespaces=True, wait=True):
+    env = {
+        "PATH": os.environ["PATH"],
+        "HOME": str(root),
+        "AUTOGRADER_ROOT": str(root),
+        "PCL_GRADER_VENV": sys.prefix,
+        "PCL_SANDBOX_NAMESPACES": "1" if namespaces else "0",
+    }
+    command = [str(root / "source" / "run_autograder")]
+    if not wait:
+        return subprocess.Popen(
+            command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True
+        )
+    completed = subprocess.run(command, env=env, capture_output=True, text=True, timeout=900)
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    results = load_results(root / "results" / "results.json")
+    return results, completed.stdout
+
+
+def by_function(results):
+    totals = {}
+    for test in results["tests"]:
+        score, maximum = totals.get(test["tags"][0], (0, 0))
+        totals[test["tags"][0]] = (score + test["score"], maximum + test["max_score"])
+    return totals
+
+
+def test_the_archive_has_gradescope_layout_and_no_reference_code(archive, tmp_path):
+    with zipfile.ZipFile(archive) as unpacked:
+        names = unpacked.namelist()
+        modes = {info.filename: (info.external_attr >> 16) & 0o777 for info in unpacked.infolist()}
+        unpacked.extractall(tmp_path)
+    assert modes["setup.sh"] == modes["run_autograder"] == 0o755
+    assert "course/tests/hidden/test_hidden.py" in names and "course/grading/plugin.py" in names
+    assert not [n for n in names if n.startswith(("course/solutions", "course/tests/mutants", "course/tests/project"))]
+    assert find_leaks(tmp_path) == []
+    # The leak check would see the reference, had it been packed.
+    planted = tmp_path / "course" / "pcl_course" / "pca.py"
+    planted.write_text(reference_source("pca"))
+    assert find_leaks(tmp_path)
+
+
+def test_the_reference_uploaded_as_a_repository_gets_full_marks(archive, tmp_path):
+    root = autograder_root(archive, tmp_path / "autograder")
+    reference_package(root / "submission" / "my-repo" / "pcl_course")
+    results, printed = run_autograder(root)
+    assert results["score"] == sum(t["max_score"] for t in results["tests"]) > 0
+    assert {t["tags"][0] for t in results["tests"]} == set(GRADED_FUNCTIONS)
+    hidden = [t for t in results["tests"] if t["visibility"] == "after_published"]
+    assert hidden and all("hidden" in t["name"] for t in hidden)
+    assert all(t["visibility"] == "visible" for t in results["tests"] if t not in hidden)
+    first, isolation = results["output"].splitlines()[:2]
+    assert first == "Graded from my-repo/pcl_course/: " + ", ".join(f"`{m}.py`" for m in EXERCISE_MODULES) + "."
+    assert isolation.startswith("isolated: bubblewrap")
+    assert "Traceback" not in printed
+
+
+def test_the_stubs_uploaded_as_the_package_folder_get_nothing(archive, tmp_path):
+    root = autograder_root(archive, tmp_path / "autograder")
+    shutil.copytree(REPO_ROOT / "pcl_course", root / "submission" / "pcl_course")
+    results, _ = run_autograder(root)
+    assert results["score"] == 0 and results["tests"]
+    assert all(t["status"] == "failed" for t in results["tests"])
+    assert results["output"].startswith("Graded from pcl_course/: ")
+
+
+@needs_root
+def test_a_wrong_module_uploaded_alone_is_graded_without_namespaces(archive, tmp_path):
+    """Gradescope's case: no namespaces, so a dedicated uid and a seccomp filter are the walls."""
+    root = autograder_root(archive, tmp_path / "autograder")
+    wrong = reference_source("pca").replace(
+        "covariance = centred.T @ centred / points.shape[0]",
+        "covariance = centred.T @ centred / (points.shape[0] - 1)",
+    )
+    assert wrong != reference_source("pca")
+    (root / "submission" / "pca.py").write_text(wrong)
+    (root / "submission" / "_kernels.py").write_text(reference_source("_kernels"))
+    (root / "submission" / "notes.txt").write_text("my notes")
+    results, _ = run_autograder(root, namespaces=False)
+    lines = results["output"].splitlines()
+    assert lines[0] == (
+        "Graded from the uploaded files: `pca.py`. Missing (graded as the course's stub, 0 points): "
+        + ", ".join(f"`{m}.py`" for m in EXERCISE_MODULES if m != "pca")
+        + ". Not graded (not exercise modules): `_kernels.py`."
+    )
+    assert lines[1].startswith("isolated: dedicated uid") and "seccomp" in lines[1]
+    totals = by_function(results)
+    assert 0 < totals["pca"][0] < totals["pca"][1]  # the N - 1 covariance loses some of pca's points
+    assert totals["kernel_matrix"][0] == totals["kernel_matrix"][1]  # pca.py's other functions are right
+    assert totals["fit_plane"][0] == 0
+
+
+SPY = """
+import json, os, socket
+
+
+def chamfer_distance(a, b):
+    found = {"readable": [], "writable": [], "network": None}
+    for path in %(readable)r:
+        try:
+            os.listdir(path) if os.path.isdir(path) else open(path).read(1)
+            found["readable"].append(path)
+        except OSError:
+            pass
+    for path in %(writable)r:
+        try:
+            with open(path, "w") as handle:
+                handle.write('{"score": 1000, "tests": []}')
+            found["writable"].append(path)
+        except OSError:
+            pass
+    try:
+        socket.create_connection(("127.0.0.1", %(port)d), timeout=1).close()
+        found["network"] = "connected"
+    except OSError as exc:
+        found["network"] = type(exc).__name__
+    raise RuntimeError("SPY" + json.dumps(found) + "YPS")  # not ValueError: that passes the input checks
+"""
+
+
+@needs_root
+@pytest.mark.parametrize("namespaces", [True, False], ids=["bubblewrap", "uid"])
+def test_a_hostile_submission_reads_writes_and_reaches_nothing(archive, tmp_path, namespaces):
+    server = socket.create_server(("127.0.0.1", 0))  # the grader's network: never reached
+    server.settimeout(0.1)
+    root = autograder_root(archive, tmp_path / "autograder")
+    course = root / "source" / "course"
+    readable = [str(course / "tests" / "hidden" / "test_hidden.py"), str(course / "grading"), str(root / "source")]
+    writable = [str(root / "results" / "results.json"), str(course / "grading" / "plugin.py")]
+    (root / "submission" / "metrics.py").write_text(
+        SPY % {"readable": readable, "writable": writable, "port": server.getsockname()[1]}
+    )
+    _make_reachable(root / "results")  # the folders above the mock /autograder: as open as / is
+    results, printed = run_autograder(root, namespaces=namespaces)
+    assert results["score"] == 0
+    outputs = [t["output"] for t in results["tests"] if t["tags"][0] == "chamfer_distance" and "SPY" in t["output"]]
+    assert outputs, [t["output"] for t in results["tests"] if t["tags"][0] == "chamfer_distance"]
+    found = json.loads(outputs[0][outputs[0].index("SPY") + 3 : outputs[0].index("YPS")])
+    assert found["readable"] == [] and found["writable"] == []
+    # bubblewrap: the sandbox's own, empty loopback refuses; the uid level: seccomp refuses the socket.
+    assert found["network"] == ("ConnectionRefusedError" if namespaces else "PermissionError")
+    with pytest.raises(TimeoutError):
+        server.accept()
+    server.close()
+    assert "plugin" not in printed and "Traceback" not in printed
+
+
+def test_an_upload_without_code_or_with_a_link_gets_one_line(archive, tmp_path):
+    root = autograder_root(archive, tmp_path / "autograder")
+    (root / "submission" / "README.md").write_text("I forgot my code")
+    results, _ = run_autograder(root)
+    assert results["score"] == 0 and results["tests"] == []
+    assert results["output"].startswith("submission refused: no pcl_course/ folder and none of pca.py")
+    (root / "submission" / "pca.py").symlink_to(root / "source" / "course" / "pcl_course" / "pca.py")
+    results, _ = run_autograder(root)
+    assert results["output"] == "submission refused: pca.py is a symbolic link: submit regular files only"
+    (root / "submission" / "pca.py").unlink()
+    for name in ("a", "b"):
+        (root / "submission" / name / "pcl_course").mkdir(parents=True)
+    results, _ = run_autograder(root)
+    assert "several pcl_course/ folders (a/pcl_course, b/pcl_course)" in results["output"]
+
+
+def test_a_killed_run_leaves_valid_partial_results(archive, tmp_path):
+    root = autograder_root(archive, tmp_path / "autograder")
+    reference_package(root / "submission" / "pcl_course")
+    process = run_autograder(root, wait=False)
+    results_file = root / "results" / "results.json"
+    deadline = time.monotonic() + 300
+    passed = []
+    while time.monotonic() < deadline and len(passed) < 3:
+        time.sleep(0.5)
+        if results_file.exists():
+            passed = [t for t in json.loads(results_file.read_text())["tests"] if t["status"] == "passed"]
+    os.killpg(process.pid, signal.SIGKILL)
+    process.wait()
+    results = load_results(results_file)
+    assert len(passed) >= 3
+    assert any(t["output"].startswith("not run:") for t in results["tests"])
+    assert not [p for p in Path(results_file.parent).iterdir() if p.name != "results.json"]
