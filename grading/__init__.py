@@ -1,6 +1,6 @@
 """The course autograder.
 
-* :mod:`grading.cli` -- ``python -m grading grade | batch | release``.
+* :mod:`grading.cli` -- ``python -m grading grade | batch | release | gradescope | autograde | similarity``.
 * :mod:`grading.plugin` -- pytest plugin: the ``impl`` fixture that hands the
   implementation under test to graded tests, points per test, per-test
   timeouts, short feedback and the results file.
@@ -16,6 +16,8 @@
 * :mod:`grading.config` -- every limit and constant of the grader.
 * :mod:`grading.errors` -- the grader's own exceptions.
 * :mod:`grading.release` and :mod:`grading.leakcheck` -- the student repository.
+* :mod:`grading.gradescope` -- the Gradescope archive, and `autograde` inside it.
+* :mod:`grading.similarity` -- the similarity report of a class (copydetect).
 """
 
 from pathlib import Path

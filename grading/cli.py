@@ -19,6 +19,10 @@ Grade a whole class, one submission per subdirectory, in parallel::
 
     python -m grading batch submissions/ --csv marks.csv
 
+Pairwise similarity of a class's exercise modules (``grading/similarity.py``)::
+
+    python -m grading similarity submissions/ --report similarity.html
+
 Write the Gradescope autograder archive (``grading/gradescope.py``)::
 
     python -m grading gradescope _build/gradescope/autograder.zip
@@ -197,6 +201,51 @@ def grade(args):
     return 0
 
 
+GRADEBOOK_IDENTITY = ("Student", "ID", "SIS User ID", "SIS Login ID", "Section")  # Canvas's gradebook export
+
+
+def write_gradebook(path, assignment, graded, roster=None):
+    """Write the marks in the layout of Canvas's gradebook (its export, re-imported).
+
+    Columns ``Student, ID, SIS User ID, SIS Login ID, Section`` and one
+    column ``assignment`` holding each total, after a ``Points Possible``
+    row. With ``roster`` (a gradebook exported from the course), each
+    submission folder is matched to the student whose SIS Login ID, SIS
+    User ID or ID it is named after, and every identity column is copied
+    from the roster; students without a submission get an empty cell (no
+    change on import). Without it, the folder name fills ``Student`` and
+    ``SIS Login ID``.
+    """
+    marks = {name: summary for name, summary, _ in graded}
+    possible = max((max_score(s) for s in marks.values() if s), default=0)
+    rows = []
+    if roster:
+        with open(roster, newline="", encoding="utf-8-sig") as handle:
+            students = [row for row in csv.DictReader(handle) if row.get("Student", "").strip() != "Points Possible"]
+        missing = [column for column in GRADEBOOK_IDENTITY if students and column not in students[0]]
+        if missing:
+            raise SystemExit(
+                f"error: the roster {roster} has no column {', '.join(missing)}: export it from the gradebook"
+            )
+        matched = set()
+        for student in students:
+            keys = [student.get(c, "").strip() for c in ("SIS Login ID", "SIS User ID", "ID")]
+            name = next((key for key in keys if key and key in marks), None)
+            summary = marks.get(name)
+            matched.add(name)
+            rows.append([*(student.get(c, "") for c in GRADEBOOK_IDENTITY), f"{summary['score']:g}" if summary else ""])
+        for name in sorted(set(marks) - matched):
+            print(f"{name}: in no roster row (by SIS Login ID, SIS User ID or ID): not in the gradebook file")
+    else:
+        rows = [[name, "", "", name, "", f"{s['score']:g}" if s else ""] for name, s in marks.items()]
+    with open(path, "w", newline="") as handle:
+        writer = csv.writer(handle)
+        writer.writerow([*GRADEBOOK_IDENTITY, assignment])
+        writer.writerow(["Points Possible", "", "", "", "", f"{possible:g}"])
+        writer.writerows(rows)
+    print(f"Gradebook (Canvas layout, column {assignment!r}) written to {path}")
+
+
 def batch(args):
     root = Path(args.directory).resolve()
     # lexists: a linked submission or pcl_course is listed, then refused by staging.
@@ -259,12 +308,33 @@ def batch(args):
                     *[f"{per_function.get(f, (0, 0))[0]:g}" for f in functions],
                 ]
             )
+    if args.gradebook:
+        write_gradebook(args.gradebook, args.assignment, graded, args.roster)
     for name, summary, output in graded:
         mark = f"{summary['score']:g} / {max_score(summary):g}" if summary else "grading failed"
         print(f"{name}: {mark}")
         if summary is None:
             print(output, file=sys.stderr)
     print(f"Marks written to {csv_path}; results files in {out}")
+    return 0
+
+
+def similarity(args):
+    from grading.similarity import DISPLAY_THRESHOLD, compare_class, render_report
+
+    root = Path(args.directory)
+    if not root.is_dir():
+        raise SystemExit(f"error: {root} is not a folder")
+    threshold = DISPLAY_THRESHOLD if args.threshold is None else args.threshold
+    pairs, skipped = compare_class(root)
+    report = Path(args.report)
+    report.write_text(render_report(pairs, skipped, threshold, args.top))
+    for line in skipped:
+        print(line)
+    shown = [p for p in pairs if p.similarity >= threshold][: args.top]
+    for pair in shown[:10]:
+        print(f"{pair.similarity:4.0%}  {pair.module}.py  {pair.first}  {pair.second}")
+    print(f"{len(shown)} pairs at or above {threshold:.0%}; report written to {report}")
     return 0
 
 
@@ -312,6 +382,15 @@ def main(argv=None):
     b.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
     b.add_argument("--jobs", type=int, help="submissions graded at once (default: number of cores)")
     b.add_argument("-k", help="select tests as pytest -k does")
+    b.add_argument("--gradebook", metavar="CSV", help="also write the totals in Canvas's gradebook layout here")
+    b.add_argument(
+        "--assignment", default="Lecture 1 exercises", help="the gradebook column of the totals (Canvas assignment)"
+    )
+    b.add_argument(
+        "--roster",
+        metavar="CSV",
+        help="a gradebook exported from Canvas: submission folders are matched to its students",
+    )
     b.add_argument(
         "--allow-unisolated",
         action="store_true",
@@ -325,6 +404,17 @@ def main(argv=None):
         help="the published student repository whose grader the students' workflow checks out "
         "(default: the repository variable PCL_COURSE_REPOSITORY)",
     )
+    s = commands.add_parser("similarity", help="pairwise similarity of the exercise modules across a class")
+    s.add_argument("directory", help="a folder with one student clone (holding pcl_course/) per subdirectory")
+    s.add_argument("--report", default="similarity.html", help="the HTML report to write (default similarity.html)")
+    s.add_argument(
+        "--threshold",
+        type=float,
+        default=None,
+        metavar="SHARE",
+        help="show pairs whose larger share of shared code reaches SHARE (default 0.33)",
+    )
+    s.add_argument("--top", type=int, default=100, help="show at most this many pairs (default 100)")
     z = commands.add_parser("gradescope", help="write the Gradescope autograder archive (no solutions)")
     z.add_argument("out_zip", help="the .zip to write, e.g. _build/gradescope/autograder.zip")
     a = commands.add_parser(
@@ -333,6 +423,8 @@ def main(argv=None):
     a.add_argument("--root", default="/autograder", help="the autograder folder (default /autograder)")
     a.add_argument("--budget", type=float, metavar="SECONDS", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.command == "similarity":
+        return similarity(args)
     if args.command == "gradescope":
         from grading.gradescope import build_archive
 

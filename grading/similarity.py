@@ -1,0 +1,213 @@
+"""``python -m grading similarity CLASS_DIR --report similarity.html``.
+
+Pairwise similarity of the exercise modules across a class, with
+`copydetect <https://pypi.org/project/copydetect/>`_'s winnowing
+fingerprints: each module is tokenised (names and literals folded, so a
+renamed variable does not hide a copy), its k-gram hashes are winnowed,
+and two students' ``pca.py`` are compared by the share of each one's
+tokens that the other holds too. Two kinds of text are boilerplate, and
+their hashes are removed before any comparison: the stubs' own text
+(docstrings, signatures, imports), which is in every submission, and any
+run found in more than half of the class's versions of the module (the
+way everyone writes ``as_points(points, ...)``), as MOSS's ``-m`` does.
+
+Each student's ``pcl_course/`` is read through :func:`grading.staging.stage`
+(regular files only, no link followed), so a link in a submission never
+puts another file's text into the report. The report is one self-contained
+HTML page (no script, no web font, no stylesheet fetched): the pairs ranked
+by similarity, each with both files side by side and the shared code
+highlighted. A high score is a reason to read the two files, not a verdict.
+"""
+
+import html
+import io
+import itertools
+import os
+import shutil
+import tempfile
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+from copydetect import CodeFingerprint, compare_files
+from copydetect.utils import highlight_overlap
+
+from grading import EXERCISE_MODULES, REPO_ROOT
+from grading.errors import StagingError
+from grading.staging import stage
+
+NOISE_TOKENS = 25  # copydetect's default k: shorter shared runs are noise
+# A fingerprint found in more than this share of a class's versions of a
+# module is the way everyone writes it (``x - x.mean(axis=0)``), not a copy:
+# it joins the boilerplate, as in MOSS's -m option. A pair is never common.
+COMMON_SHARE = 0.5
+COMMON_MIN_STUDENTS = 3
+DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
+HIGHLIGHT = ('<mark class="shared">', "</mark>")
+
+
+@dataclass(frozen=True)
+class Pair:
+    """Two students' versions of one exercise module, compared.
+
+    ``similarity`` is the larger of the two shares (the part of one file
+    found in the other): a short file copied into a long one still scores
+    high.
+    """
+
+    module: str
+    first: str
+    second: str
+    first_share: float
+    second_share: float
+    shared_tokens: int
+    first_html: str
+    second_html: str
+
+    @property
+    def similarity(self):
+        return max(self.first_share, self.second_share)
+
+
+def _boilerplate_hashes(stubs):
+    import numpy as np
+
+    hashes = []
+    for path in sorted(Path(stubs).glob("*.py")):
+        hashes.extend(CodeFingerprint(str(path), NOISE_TOKENS, 1).hashes)  # a set of k-gram hashes
+    return np.unique(np.array(hashes))
+
+
+def _fingerprints(module, texts, boilerplate):
+    return {
+        student: CodeFingerprint(f"{module}.py", NOISE_TOKENS, 1, boilerplate, fp=io.StringIO(text))
+        for student, text in texts.items()
+    }
+
+
+def _common_hashes(module, texts, boilerplate):
+    """The boilerplate plus every fingerprint too common in the class to mean copying."""
+    import numpy as np
+
+    counts = Counter(
+        h for fingerprint in _fingerprints(module, texts, boilerplate).values() for h in fingerprint.hashes
+    )
+    limit = max(COMMON_MIN_STUDENTS - 1, COMMON_SHARE * len(texts))
+    common = [h for h, count in counts.items() if count > limit]
+    return np.unique(np.concatenate([np.asarray(boilerplate, dtype=np.int64), np.array(common, dtype=np.int64)]))
+
+
+def _student_modules(class_dir, into):
+    """Stage each student's ``pcl_course/``; return ({student: {module: text}}, skipped lines)."""
+    modules, skipped = {}, []
+    for student in sorted(p for p in Path(class_dir).iterdir() if os.path.lexists(p / "pcl_course")):
+        try:
+            staged = stage(student / "pcl_course", Path(into) / student.name)
+        except StagingError as exc:
+            skipped.append(f"{student.name}: not compared: {exc}")
+            continue
+        modules[student.name] = {
+            name: (staged.package / f"{name}.py").read_text(encoding="utf-8", errors="replace")
+            for name in EXERCISE_MODULES
+            if f"{name}.py" in staged.files
+        }
+    return modules, skipped
+
+
+def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
+    """Compare every pair of students' versions of each exercise module.
+
+    Parameters
+    ----------
+    class_dir : path
+        One folder per student, each holding ``pcl_course/`` (the layout
+        of ``python -m grading batch``).
+    stubs : path
+        The stubs whose text is boilerplate (default: the course's).
+
+    Returns
+    -------
+    pairs : list of Pair
+        Every compared pair with shared code, most similar first.
+    skipped : list of str
+        One line per submission that could not be read.
+    """
+    boilerplate = _boilerplate_hashes(stubs)
+    work = tempfile.mkdtemp(prefix="grading-similarity-")
+    try:
+        modules, skipped = _student_modules(class_dir, work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    pairs = []
+    for module in EXERCISE_MODULES:
+        texts = {student: files[module] for student, files in modules.items() if module in files}
+        fingerprints = _fingerprints(module, texts, _common_hashes(module, texts, boilerplate))
+        for first, second in itertools.combinations(sorted(fingerprints), 2):
+            a, b = fingerprints[first], fingerprints[second]
+            tokens, (share_a, share_b), (slices_a, slices_b) = compare_files(a, b)
+            if tokens == 0:
+                continue
+            pairs.append(
+                Pair(
+                    module,
+                    first,
+                    second,
+                    float(share_a),
+                    float(share_b),
+                    int(tokens),
+                    highlight_overlap(a.raw_code, slices_a, *HIGHLIGHT, escape_html=True)[0],
+                    highlight_overlap(b.raw_code, slices_b, *HIGHLIGHT, escape_html=True)[0],
+                )
+            )
+    pairs.sort(key=lambda pair: (-pair.similarity, pair.module, pair.first, pair.second))
+    return pairs, skipped
+
+
+STYLE = """
+body { font-family: system-ui, sans-serif; margin: 2em; color: #222; }
+table { border-collapse: collapse; margin-bottom: 2em; }
+th, td { border: 1px solid #ccc; padding: 0.3em 0.7em; text-align: left; }
+td.number { text-align: right; font-variant-numeric: tabular-nums; }
+.pair { margin: 2em 0; border-top: 2px solid #888; }
+.sides { display: grid; grid-template-columns: 1fr 1fr; gap: 1em; }
+pre { background: #f7f7f7; padding: 0.7em; overflow-x: auto; font-size: 0.85em; }
+mark.shared { background: #ffd0d0; }
+"""
+
+
+def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
+    """The report: one HTML page, self-contained."""
+    shown = [pair for pair in pairs if pair.similarity >= threshold][:top]
+    rows = "\n".join(
+        f'<tr><td><a href="#pair-{i}">{i}</a></td><td>{html.escape(p.module)}.py</td>'
+        f"<td>{html.escape(p.first)}</td><td>{html.escape(p.second)}</td>"
+        f'<td class="number">{p.first_share:.0%}</td><td class="number">{p.second_share:.0%}</td>'
+        f'<td class="number">{p.shared_tokens}</td></tr>'
+        for i, p in enumerate(shown, start=1)
+    )
+    sections = "\n".join(
+        f'<section class="pair" id="pair-{i}"><h2>{i}. {html.escape(p.module)}.py: '
+        f"{html.escape(p.first)} and {html.escape(p.second)} ({p.similarity:.0%})</h2>"
+        f'<div class="sides"><div><h3>{html.escape(p.first)} ({p.first_share:.0%} shared)</h3>'
+        f"<pre>{p.first_html}</pre></div>"
+        f"<div><h3>{html.escape(p.second)} ({p.second_share:.0%} shared)</h3>"
+        f"<pre>{p.second_html}</pre></div></div></section>"
+        for i, p in enumerate(shown, start=1)
+    )
+    notes = "".join(f"<li>{html.escape(line)}</li>" for line in skipped)
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>Similarity report</title>
+<style>{STYLE}</style></head><body>
+<h1>Similarity of the exercise modules</h1>
+<p>{len(pairs)} pairs share code beyond the stubs; {len(shown)} reach {threshold:.0%} of a file and are shown.
+The share is the part of a student's file (stub text removed, names folded) that the other file holds too.
+A high share is a reason to read both files, not a verdict.</p>
+{f"<ul>{notes}</ul>" if notes else ""}
+<table><thead><tr><th>#</th><th>module</th><th>student</th><th>student</th>
+<th>share of the first</th><th>share of the second</th><th>shared tokens</th></tr></thead>
+<tbody>
+{rows}
+</tbody></table>
+{sections}
+</body></html>
+"""

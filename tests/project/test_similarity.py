@@ -1,0 +1,147 @@
+"""The similarity report (``python -m grading similarity``) on a planted class.
+
+alice and bob hand in the same ``pca`` (bob renamed every local name and
+dropped the comments); carol and dave wrote their own correct ones (plain
+loops; an SVD); erin and frank left the stub as it is. The near-copy must
+rank first, the independent solutions must stay below the display
+threshold, and the stub's own text must never make a pair.
+"""
+
+import re
+import shutil
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+from grading import REPO_ROOT
+from grading.similarity import DISPLAY_THRESHOLD, compare_class
+
+STUB_BODY = '    raise NotImplementedError("pca: not implemented yet")\n'
+
+ALICE = """
+points = as_points(points, min_columns=1, allow_empty=False)
+centred = points - points.mean(axis=0)
+if correlation:
+    # A constant column has no spread: leave it at zero instead of 0/0.
+    varying = np.ptp(points, axis=0) > 0
+    std = centred.std(axis=0)
+    centred = np.divide(centred, std, out=np.zeros_like(centred), where=varying)
+covariance = centred.T @ centred / points.shape[0]
+eigenvalues, eigenvectors = np.linalg.eigh(covariance)
+if sort:
+    eigenvalues, eigenvectors = eigenvalues[::-1], eigenvectors[:, ::-1]
+return np.ascontiguousarray(eigenvalues), np.ascontiguousarray(eigenvectors)
+"""
+
+RENAMES = {"centred": "xc", "varying": "keep", "std": "sd", "covariance": "h", "eigenvalues": "w", "eigenvectors": "v"}
+
+CAROL = """
+rows = as_points(points, min_columns=1, allow_empty=False)
+n, d = rows.shape
+mean = [sum(rows[i, j] for i in range(n)) / n for j in range(d)]
+centred = [[rows[i, j] - mean[j] for j in range(d)] for i in range(n)]
+if correlation:
+    for j in range(d):
+        spread = math.sqrt(sum(centred[i][j] ** 2 for i in range(n)) / n)
+        for i in range(n):
+            centred[i][j] = centred[i][j] / spread if spread > 0 else 0.0
+h = np.zeros((d, d))
+for a in range(d):
+    for b in range(d):
+        h[a, b] = sum(centred[i][a] * centred[i][b] for i in range(n)) / n
+values, vectors = np.linalg.eigh(h)
+if sort:
+    order = np.argsort(values)[::-1]
+    values, vectors = values[order], vectors[:, order]
+return values, vectors  # <script>alert(1)</script>
+"""
+
+DAVE = """
+x = as_points(points, min_columns=1, allow_empty=False)
+xc = x - x.mean(axis=0)
+if correlation:
+    xc = xc / np.where(np.ptp(x, axis=0) > 0, xc.std(axis=0), np.inf)
+_, s, vt = np.linalg.svd(xc, full_matrices=True)
+lam = np.zeros(x.shape[1])
+lam[: len(s)] = s**2 / len(x)
+return lam, vt.T
+"""
+
+
+def student(root, name, body=None):
+    """A student's clone: the stubs, with ``pca``'s body written when given."""
+    package = root / name / "pcl_course"
+    shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
+    if body is not None:
+        stub = (package / "pca.py").read_text()
+        assert stub.count(STUB_BODY) == 1
+        header = "import math\n\nimport numpy as np\n\n" if "math." in body else "import numpy as np\n\n"
+        source = header + stub.replace(STUB_BODY, textwrap.indent(textwrap.dedent(body).strip() + "\n", "    "))
+        (package / "pca.py").write_text(source)
+    return package
+
+
+@pytest.fixture(scope="module")
+def planted_class(tmp_path_factory):
+    root = tmp_path_factory.mktemp("class")
+    bob = ALICE
+    for old, new in RENAMES.items():
+        bob = re.sub(rf"\b{old}\b", new, bob)
+    bob = "\n".join(line for line in bob.splitlines() if not line.strip().startswith("#"))
+    assert "centred" not in bob and "covariance" not in bob
+    student(root, "alice", ALICE)
+    student(root, "bob", bob)
+    student(root, "carol", CAROL)
+    student(root, "dave", DAVE)
+    student(root, "erin")
+    student(root, "frank")
+    mallory = student(root, "mallory")
+    (mallory / "pca.py").unlink()
+    (mallory / "pca.py").symlink_to(REPO_ROOT / "solutions" / "pca.py")
+    return root
+
+
+def test_the_renamed_copy_ranks_first_and_independent_solutions_stay_below(planted_class):
+    pairs, skipped = compare_class(planted_class)
+    first = pairs[0]
+    assert (first.module, first.first, first.second) == ("pca", "alice", "bob")
+    assert first.similarity > 0.8
+    independent = [p for p in pairs if {p.first, p.second} != {"alice", "bob"}]
+    assert all(p.similarity < DISPLAY_THRESHOLD for p in independent), [
+        (p.module, p.first, p.second, round(p.similarity, 2)) for p in independent
+    ]
+    # The stub's text is boilerplate: untouched stubs never pair.
+    assert not [p for p in pairs if {p.first, p.second} == {"erin", "frank"}]
+    assert skipped == ["mallory: not compared: pcl_course/pca.py is a symbolic link: submit regular files only"]
+
+
+def test_the_report_is_one_self_contained_page_with_the_shared_code_marked(planted_class, tmp_path):
+    report = tmp_path / "similarity.html"
+    completed = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "similarity",
+            str(planted_class),
+            "--report",
+            str(report),
+            "--threshold",
+            "0",
+        ],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert completed.returncode == 0, completed.stderr
+    first_line = completed.stdout.splitlines()[1]
+    assert re.fullmatch(r"\s*\d+%\s+pca\.py\s+alice\s+bob", first_line), completed.stdout
+    page = report.read_text()
+    assert 'id="pair-1"><h2>1. pca.py: alice and bob' in page
+    assert '<mark class="shared">' in page
+    assert not re.search(r"""(src|href)=["'](https?:)?//""", page)  # nothing fetched from the web
+    assert "<script>" not in page and "&lt;script&gt;" in page  # students' text is escaped
+    assert "from solutions" not in page and "Test constancy on the data" not in page  # no link was followed
