@@ -41,13 +41,37 @@ def check_array(value, name, shape=None, dtype="float64"):
     return value
 
 
+def _dtype_note(value):
+    """A sentence when ``value`` is an array of another dtype than float64 (the contract's)."""
+    dtype = getattr(value, "dtype", None)
+    if dtype is None or dtype == np.float64 or dtype.kind in "iub":
+        return ""
+    return f"\n  note: your array has dtype {dtype}; the contract's outputs are float64"
+
+
+def _with_hint(message, hint):
+    return f"{message}\n  hint: {hint}" if hint else message
+
+
 def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
-    """``np.allclose`` with a message naming the worst entry."""
+    """``np.allclose`` with a message naming the worst entry.
+
+    The ``hint`` is given in every failure (a wrong shape too), and an
+    answer of another floating dtype than float64 is named as such.
+    """
+    note = _dtype_note(actual)
+    actual = np.asarray(actual)
+    actual = actual.real if np.iscomplexobj(actual) and not np.any(actual.imag) else actual
     actual = np.asarray(actual, dtype=float)
     expected = np.asarray(expected, dtype=float)
     if actual.shape != expected.shape:
+        rows = ""
+        if actual.ndim == expected.ndim >= 1 and actual.shape[1:] == expected.shape[1:]:
+            difference = actual.shape[0] - expected.shape[0]
+            rows = f" ({abs(difference)} {'more' if difference > 0 else 'fewer'} rows than expected)"
         raise CheckFailed(
-            f"{name}: expected shape {expected.shape}, got {actual.shape}", rule=f"{name} has the wrong shape"
+            _with_hint(f"{name}: expected shape {expected.shape}, got {actual.shape}{rows}{note}", hint),
+            rule=f"{name} has the wrong shape",
         )
     if np.allclose(actual, expected, rtol=rtol, atol=atol, equal_nan=True):
         return
@@ -57,11 +81,9 @@ def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
     message = (
         f"{name} is wrong: at index {tuple(int(i) for i in worst)} expected "
         f"{expected[worst]:.6g}, got {actual[worst]:.6g}\n"
-        f"  got {preview(actual)}"
+        f"  got {preview(actual)}{note}"
     )
-    if hint:
-        message += f"\n  hint: {hint}"
-    raise CheckFailed(message, rule=f"{name} is wrong")
+    raise CheckFailed(_with_hint(message, hint), rule=f"{name} is wrong")
 
 
 def check_unit_columns_match(actual, expected, name, atol=1e-6, hint=""):

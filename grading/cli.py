@@ -76,6 +76,7 @@ def run_graded_tests(
     functions=(),
     budget=None,
     note=None,
+    diagnose_always=False,
 ):
     """Run the graded tests on ``impl_dir``; return pytest's exit code and its output."""
     if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
@@ -123,6 +124,8 @@ def run_graded_tests(
         command += ["--budget", str(budget)]
     if note:
         command += ["--submission-note", note]
+    if diagnose_always:
+        command.append("--diagnose-always")
     if junit:
         command += ["--junitxml", str(junit)]
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
@@ -180,6 +183,7 @@ def grade(args):
         require_isolation=args.require_isolation,
         functions=args.function,
         budget=args.budget,
+        diagnose_always=args.diagnose_always,
     )
     if code == PYTEST_EXIT_NO_TESTS:
         print(f"error: no graded test matches -k {args.k!r}", file=sys.stderr)
@@ -376,6 +380,7 @@ def main(argv=None):
     g.add_argument(
         "--impl-module", action="append", default=[], metavar="MODULE=FILE", help=argparse.SUPPRESS
     )  # mutation checks: replace one module
+    g.add_argument("--diagnose-always", action="store_true", help=argparse.SUPPRESS)  # false-diagnosis checks
     b = commands.add_parser("batch", help="grade every submission in a folder, in parallel")
     b.add_argument("directory", help="a folder with one student clone (holding pcl_course/) per subdirectory")
     b.add_argument("--csv", help="where to write the marks (default: OUT/marks.csv)")

@@ -36,6 +36,9 @@ HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plot
 TEST_TIMEOUT = 60.0  # seconds of one graded test (pytest-timeout), ample for plain loops
 CALL_TIMEOUT = 30.0  # wall-clock seconds of one sandboxed call (its module's import included)
 MAX_FEEDBACK_LINES = 12  # of one failed test's feedback
+# Values (array entries) of one call's arguments kept for the diagnosis
+# (grading/diagnosis.py); larger calls are recorded without their arguments.
+DIAGNOSIS_MAX_VALUES = 2_000_000
 # Wall-clock seconds of one submission's whole grading: tests not started by
 # then score 0 with a line that says so (a test under way may add its own
 # TEST_TIMEOUT), within Gradescope's default limit of 10 minutes.

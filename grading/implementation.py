@@ -6,6 +6,7 @@ any folder with the same module files. It is imported as a private package
 this repository stay what the tests use.
 """
 
+import copy
 import importlib.util
 import itertools
 import os
@@ -16,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
+from grading.diagnosis import Call, changed, snapshot
 from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
 from grading.forbidden import scan_package
 
@@ -37,6 +39,19 @@ def describe(value):
 def describe_call(name, args, kwargs):
     parts = [describe(a) for a in args] + [f"{k}={describe(v)}" for k, v in kwargs.items()]
     return f"{name}({', '.join(parts)})"
+
+
+def _where_in(exc, impl):
+    """file:line of the innermost frame of the implementation in ``exc``'s traceback."""
+    roots = [impl.directory, *impl.overrides.values()]
+    where = None
+    tb = exc.__traceback__
+    while tb is not None:
+        path = Path(tb.tb_frame.f_code.co_filename)
+        if any(path == root or root in path.parents for root in roots):
+            where = f"{path.name}:{tb.tb_lineno}"
+        tb = tb.tb_next
+    return where
 
 
 class Implementation:
@@ -61,6 +76,8 @@ class Implementation:
         self.package = f"_graded_impl_{next(_counter)}"
         self._modules = {}
         self.last_call = None
+        self.current_test = None  # set by the plugin: the test under way
+        self.calls = {}  # graded function -> [Call], for the diagnosis
         self.worker = None
         self.staged = None
         self.refusal = None
@@ -137,13 +154,38 @@ class Implementation:
 
         def graded_call(*args, **kwargs):
             self.last_call = describe_call(name, args, kwargs)
+            kept = snapshot(args, kwargs)
+            call = Call(self.current_test, *(kept or ((), {})), kept=kept is not None)
+            self.calls.setdefault(name, []).append(call)
             try:
-                return function(*args, **kwargs)
+                result = function(*args, **kwargs)
             except NotImplementedError:
+                call.error_type, call.error = "NotImplementedError", "not implemented"
                 raise NotImplementedYet(name) from None
+            except Exception as exc:
+                call.error_type = type(exc).__name__
+                call.error = (str(exc).splitlines() or [""])[0][:200]
+                call.where = getattr(exc, "where", None) or _where_in(exc, self)
+                raise
+            finally:
+                if kept is not None:
+                    call.modified = changed(kept[0], args) or changed(list(kept[1].values()), list(kwargs.values()))
+            call.result = copy.deepcopy(result) if kept is not None else None
+            return result
 
         graded_call.__name__ = name
         return graded_call
+
+    def source(self, module):
+        """The text of the implementation's ``module.py`` (read, never run), or None."""
+        if self.staged is not None:
+            path = self.staged.package / f"{module}.py"
+        else:
+            path = self.overrides.get(module, self.directory / f"{module}.py")
+        try:
+            return Path(path).read_text(encoding="utf-8", errors="replace")
+        except OSError:
+            return None
 
     def close(self):
         if self.worker is not None:

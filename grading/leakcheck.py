@@ -83,13 +83,14 @@ def _public_api_lines(source):
     return {
         number
         for node in tree.body
-        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "__all__" for t in node.targets)
+        if isinstance(node, (ast.Import, ast.ImportFrom))
+        or (isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "__all__" for t in node.targets))
         for number in range(node.lineno, node.end_lineno + 1)
     }
 
 
 def code_lines(source):
-    """Code lines, minus docstrings, comments, imports, ``__all__`` and
+    """Code lines, minus docstrings, comments, imports (whole statements), ``__all__`` and
     input-validation boilerplate (the same in every module, and in the helpers)."""
     lines, in_docstring = [], False
     public_api = _public_api_lines(source)

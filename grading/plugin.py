@@ -31,13 +31,21 @@ from pathlib import Path
 
 import pytest
 
-from grading import GRADED_FUNCTIONS
+from grading import GRADED_FUNCTIONS, diagnosis
 from grading import config as grading_config
+from grading.diagnosis import Outcome
 from grading.errors import CheckFailed, ForbiddenAPI, NotImplementedYet, SandboxError, StagingError
 from grading.implementation import Implementation
 
+try:
+    from grading import mistakes
+except ImportError:  # the student release has no catalogue of mistakes
+    mistakes = None
+
 _IMPL_KEY = pytest.StashKey[Implementation]()
 _RESULTS_KEY = pytest.StashKey[dict]()
+_OUTCOMES_KEY = pytest.StashKey[dict]()  # test id -> diagnosis.Outcome
+_DIAGNOSES_KEY = pytest.StashKey[dict]()  # function -> its diagnosis, once the tests are over
 _STARTED_KEY = pytest.StashKey[float]()
 
 
@@ -85,6 +93,11 @@ def pytest_addoption(parser):
         default=[],
         metavar="NAME",
         help="run only the graded tests of this function (their grades marker); repeatable",
+    )
+    group.addoption(
+        "--diagnose-always",
+        action="store_true",
+        help="run the diagnosis on full-marks functions too (the project's check for false diagnoses)",
     )
     group.addoption(
         "--submission-note",
@@ -253,6 +266,76 @@ def _feedback(excinfo, impl):
     return f"raised {excinfo.typename}: {first}{where}{last_call}"
 
 
+def _outcome(excinfo):
+    """How a test failed, for the diagnosis (:class:`grading.diagnosis.Outcome`)."""
+    if excinfo is None:
+        return Outcome(False, diagnosis.ERROR)
+    exc = excinfo.value
+    text = str(exc)
+    if isinstance(exc, NotImplementedYet):
+        return Outcome(False, diagnosis.NOT_IMPLEMENTED)
+    if isinstance(exc, ForbiddenAPI):
+        return Outcome(False, diagnosis.FORBIDDEN)
+    if isinstance(exc, StagingError):
+        return Outcome(False, diagnosis.REFUSED)
+    if isinstance(exc, SandboxError):
+        return Outcome(False, diagnosis.SANDBOX)
+    if isinstance(exc, CheckFailed):
+        return Outcome(False, diagnosis.CHECK, exc.rule)
+    if excinfo.typename == "Failed" and text.startswith("DID NOT RAISE"):
+        return Outcome(False, diagnosis.DID_NOT_RAISE)
+    if excinfo.typename == "Failed" and text.startswith("Timeout"):
+        return Outcome(False, diagnosis.TIMEOUT)
+    if isinstance(exc, AssertionError):
+        return Outcome(False, diagnosis.ASSERTION)
+    return Outcome(False, diagnosis.ERROR)
+
+
+def _diagnose(config):
+    """Diagnose every function that lost points; put each line into its tests' and the summary's output."""
+    impl = config.stash.get(_IMPL_KEY, None)
+    results = config.stash.get(_RESULTS_KEY, {})
+    outcomes = config.stash.get(_OUTCOMES_KEY, {})
+    if impl is None or not results:
+        return {}
+    always = config.getoption("--diagnose-always")
+    found = {}
+    for function in GRADED_FUNCTIONS:
+        tests = {
+            nodeid: outcomes[nodeid]
+            for nodeid, entry in results.items()
+            if entry["tags"] == [function] and nodeid in outcomes
+        }
+        if not tests or (not always and all(o.passed for o in tests.values())):
+            continue
+        model = mistakes.model(function) if mistakes is not None else None
+        sources = {GRADED_FUNCTIONS[function]: impl.source(GRADED_FUNCTIONS[function])}
+        if always and all(o.passed for o in tests.values()):
+            # A full-marks run, checked for false diagnoses (the project's alternatives):
+            # every test counts as failed, so any matching mistake shows.
+            tests = {nodeid: diagnosis.Outcome(False, diagnosis.CHECK) for nodeid in tests}
+        try:
+            found_here = diagnosis.diagnose(function, impl.calls.get(function, []), tests, model, sources)
+        except Exception as exc:  # the diagnosis is help, never a reason to lose a grade
+            found_here = None
+            print(f"note: the diagnosis of {function} failed: {type(exc).__name__}: {exc}")
+        if found_here is None:
+            continue
+        failed = [t for t, o in tests.items() if not o.passed]
+        line = diagnosis.explained_line(found_here, len(failed))
+        found[function] = {"id": found_here.id, "message": line, "explains": len(found_here.explains)}
+        for nodeid in found_here.explains:
+            entry = results.get(nodeid)
+            if entry is None or entry["status"] != "failed" or always or found_here.id in diagnosis.ONE_LINE_ALREADY:
+                continue
+            if found_here.id in diagnosis.ONE_CAUSE:
+                entry["output"] = f"diagnosis: {line}"  # the same cause everywhere: said once, not repeated
+            else:
+                entry["output"] = f"diagnosis: {line}\n{entry['output']}"
+    config.stash[_DIAGNOSES_KEY] = found
+    return found
+
+
 NOT_RUN = "not run: grading stopped before this test"
 
 
@@ -291,6 +374,12 @@ def _over_budget(config):
     return started is not None and time.monotonic() - started > config.getoption("--budget")
 
 
+def pytest_runtest_call(item):
+    impl = item.config.stash.get(_IMPL_KEY, None)  # created by the test's setup, the first time
+    if impl is not None:
+        impl.current_test = item.nodeid  # the calls made now are this test's (the diagnosis)
+
+
 def pytest_runtest_setup(item):
     if _is_graded(item) and _over_budget(item.config):
         pytest.skip(f"not run: the submission's time budget of {item.config.getoption('--budget'):g} s ran out")
@@ -306,8 +395,10 @@ def pytest_runtest_makereport(item, call):
     if item.nodeid not in results:
         results[item.nodeid] = _new_entry(item, f"0.{len(results) + 1}")
     entry = results[item.nodeid]
+    outcomes = item.config.stash.setdefault(_OUTCOMES_KEY, {})
     if report.when == "call" and report.passed:
         entry.update(score=entry["max_score"], status="passed", output="")
+        outcomes[item.nodeid] = Outcome(True)
     elif report.failed:
         impl = item.config.stash.get(_IMPL_KEY, None)
         if not call.excinfo:
@@ -319,6 +410,8 @@ def pytest_runtest_makereport(item, call):
         if report.when != "call":
             message = f"error in test {report.when}: {message}"
         entry.update(score=0.0, status="failed", output=message)
+        outcomes[item.nodeid] = _outcome(call.excinfo)
+        outcomes[item.nodeid].interface = item.get_closest_marker("interface") is not None
         if isinstance(
             call.excinfo.value if call.excinfo else None, (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError)
         ):
@@ -346,14 +439,16 @@ def max_score(summary):
     return sum(test["max_score"] for test in summary["tests"])
 
 
-def results_summary(results, isolation=None, execution_time=None, note=None):
+def results_summary(results, isolation=None, execution_time=None, note=None, diagnoses=None):
     """The results file's content (Gradescope's format), from the per-test entries."""
     tests = list(results.values())
     per_function = points_per_function(tests)
+    diagnoses = diagnoses or {}
     lines = [line for line in (note, isolation) if line]
     order = list(GRADED_FUNCTIONS)
     lines += [
         f"- `{function}`: {score:g} / {maximum:g}"
+        + (f" - {diagnoses[function]['message']}" if function in diagnoses else "")
         for function, (score, maximum) in sorted(per_function.items(), key=lambda kv: order.index(kv[0]))
     ]
     summary = {
@@ -363,6 +458,8 @@ def results_summary(results, isolation=None, execution_time=None, note=None):
         "stdout_visibility": "hidden",
         "tests": tests,
     }
+    if diagnoses:
+        summary["extra_data"] = {"diagnoses": diagnoses}
     return summary
 
 
@@ -377,7 +474,11 @@ def _write_results(config):
     started = config.stash.get(_STARTED_KEY, None)
     elapsed = time.monotonic() - started if started is not None else None
     summary = results_summary(
-        config.stash.get(_RESULTS_KEY, {}), isolation_note(config), elapsed, config.getoption("--submission-note")
+        config.stash.get(_RESULTS_KEY, {}),
+        isolation_note(config),
+        elapsed,
+        config.getoption("--submission-note"),
+        config.stash.get(_DIAGNOSES_KEY, None),
     )
     fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
     with os.fdopen(fd, "w") as handle:
@@ -392,6 +493,8 @@ def pytest_unconfigure(config):
 
 
 def pytest_sessionfinish(session, exitstatus):
+    if not hasattr(session.config, "workerinput"):
+        _diagnose(session.config)
     _write_results(session.config)
 
 

@@ -32,6 +32,8 @@ COPIED = [
     "benchmarks/results",
 ]  # the appendix reads the results, not the harness
 IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".ipynb_checkpoints")
+# The catalogue of known mistakes computes right answers: it stays with the instructors.
+WITHHELD = ("grading/mistakes",)
 
 TEMPLATES = Path(__file__).with_name("templates")  # the student repository's own files
 
@@ -192,6 +194,9 @@ def release(out_dir, course_repository=None):
         source = REPO_ROOT / name
         if source.is_dir():
             shutil.copytree(source, out / name, ignore=IGNORED)
+            for withheld in WITHHELD:
+                if withheld.startswith(f"{name}/"):
+                    shutil.rmtree(out / withheld, ignore_errors=True)
         elif source.exists():
             (out / name).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(source, out / name)

@@ -6,6 +6,11 @@ the xyz columns; ``h = floor((p - min) / voxel_size)`` per axis as int64;
 ``h_x + h_y * D_x + h_z * D_x * D_y``.
 """
 
+# What every solution needs (NumPy; SciPy's k-d tree is allowed; the course's input checks).
+import numpy as np  # noqa: F401
+
+from pcl_course.validation import as_points, check_choice, check_integer, check_positive, check_rng  # noqa: F401
+
 __all__ = ["voxel_grid_downsample", "approximate_voxel_downsample", "farthest_point_sampling", "normal_space_sampling"]
 
 

@@ -1,5 +1,11 @@
 """Exercises: evaluation metrics."""
 
+# What every solution needs (NumPy; SciPy's k-d tree is allowed; the course's input checks).
+import numpy as np  # noqa: F401
+from scipy.spatial import cKDTree  # noqa: F401
+
+from pcl_course.validation import as_array, as_points, check_same_shape  # noqa: F401
+
 __all__ = ["chamfer_distance", "depth_metrics"]
 
 

@@ -4,6 +4,12 @@ Use :mod:`pcl_course.neighbors` for neighbour search and
 :mod:`pcl_course.validation` for input checks. Do not call Open3D or PCL here.
 """
 
+# What every solution needs (NumPy; SciPy's k-d tree is allowed; the course's input checks).
+import numpy as np  # noqa: F401
+from scipy.spatial import cKDTree  # noqa: F401
+
+from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_same_shape  # noqa: F401
+
 __all__ = ["fit_plane", "estimate_normals"]
 
 

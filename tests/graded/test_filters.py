@@ -18,19 +18,32 @@ from grading.checks import check_array, check_close
 
 
 @pytest.mark.grades("radius_outlier_removal")
-@pytest.mark.points(2)
-def test_radius_outlier_removal_counts_other_points_within_the_radius(impl):
+@pytest.mark.points(1)
+def test_radius_outlier_removal_counts_a_neighbour_at_exactly_the_radius(impl):
+    # A chain 0, 1, 2 with spacing exactly 1.0: each point has a neighbour at distance 1.0.
+    points = np.column_stack([np.array([0.0, 1.0, 2.0]), np.zeros(3), np.zeros(3)])
+    keep = impl.radius_outlier_removal(points, 1.0, 1)
+    check_array(keep, "keep", shape=(3,), dtype="bool")
+    assert keep.tolist() == [True, True, True], (
+        f"got {keep.tolist()}: a neighbour at distance exactly 1.0 counts (distance <= radius, not <)"
+    )
+
+
+@pytest.mark.grades("radius_outlier_removal")
+@pytest.mark.points(1)
+def test_radius_outlier_removal_does_not_count_the_point_itself(impl):
     # On a line: 0, 1, 2 are a chain (spacing 1), 5 is alone, 10 and 10 coincide.
     x = np.array([0.0, 1.0, 2.0, 5.0, 10.0, 10.0])
     points = np.column_stack([x, np.zeros(6), np.zeros(6)])
-    keep = impl.radius_outlier_removal(points, 1.0, 1)
+    keep = impl.radius_outlier_removal(points, 1.5, 1)
     check_array(keep, "keep", shape=(6,), dtype="bool")
     assert keep.tolist() == [True, True, True, False, True, True], (
-        f"got {keep.tolist()}; a neighbour at distance exactly 1.0 counts (<= radius), the point itself does not"
+        f"got {keep.tolist()}: the point alone at 5 has no OTHER point within 1.5 (it does not count itself); "
+        "a duplicate of a point is another point"
     )
-    keep = impl.radius_outlier_removal(points, 1.0, 2)
+    keep = impl.radius_outlier_removal(points, 1.5, 2)
     assert keep.tolist() == [False, True, False, False, False, False], (
-        f"with min_neighbors=2 only the middle of the chain has 2 OTHER points within 1.0, got {keep.tolist()}"
+        f"with min_neighbors=2 only the middle of the chain has 2 OTHER points within 1.5, got {keep.tolist()}"
     )
 
 
@@ -45,13 +58,19 @@ def test_radius_outlier_removal_matches_brute_force(impl):
 
 
 @pytest.mark.grades("radius_outlier_removal")
-@pytest.mark.points(1)
+@pytest.mark.points(0.5)
 @pytest.mark.interface
-def test_radius_outlier_removal_empty_and_errors(impl):
+def test_radius_outlier_removal_on_an_empty_cloud(impl):
     check_array(impl.radius_outlier_removal(np.empty((0, 3)), 1.0, 2), "keep", shape=(0,), dtype="bool")
+
+
+@pytest.mark.grades("radius_outlier_removal")
+@pytest.mark.points(0.5)
+@pytest.mark.interface
+def test_radius_outlier_removal_rejects_a_bad_radius(impl):
     with pytest.raises(ValueError) as excinfo:
         impl.radius_outlier_removal(np.zeros((3, 3)), 0.0, 2)
-    assert "radius" in str(excinfo.value)
+    assert "radius" in str(excinfo.value), f"the ValueError must name 'radius', got: {excinfo.value}"
 
 
 # --- statistical_outlier_removal ----------------------------------------------------
@@ -136,6 +155,21 @@ def test_statistical_outlier_removal_uses_the_sample_standard_deviation(impl):
     keep = impl.statistical_outlier_removal(points, 1, 1.9)
     assert keep.tolist() == [True] * 5, (
         f"got {keep.tolist()}: sigma is the SAMPLE standard deviation (ddof=1): 2.5 <= 1.3 + 1.9 * 0.6708"
+    )
+
+
+@pytest.mark.grades("statistical_outlier_removal")
+@pytest.mark.points(2)
+def test_statistical_outlier_removal_keeps_an_evenly_spaced_cloud(impl):
+    # k = 1 on integers 0..9: every mean distance is exactly 1.0, so sigma = 0
+    # and the threshold mu + std_ratio * sigma is 1.0 itself: d_i <= 1.0 keeps
+    # every point (a strict < would remove them all).
+    points = np.column_stack([np.arange(10.0), np.zeros(10), np.zeros(10)])
+    keep = impl.statistical_outlier_removal(points, 1, 1.0)
+    check_array(keep, "keep", shape=(10,), dtype="bool")
+    assert keep.all(), (
+        f"got {keep.tolist()}: with equal mean distances sigma = 0 and every point is at the threshold: "
+        "keep where d_i <= mu + std_ratio * sigma (<=, not <)"
     )
 
 

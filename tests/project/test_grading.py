@@ -1,6 +1,7 @@
 """The grader grades right: full marks for the reference, zero for the stubs,
 and lost points for every wrong submission in tests/mutants."""
 
+import ast
 import subprocess
 import sys
 
@@ -9,6 +10,7 @@ from _helpers import load_results
 from _helpers import run_grader as grade
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT
+from grading.diagnosis import ONE_LINE_ALREADY
 
 
 def test_reference_gets_full_marks(reference_grading):
@@ -113,7 +115,7 @@ def test_no_matching_test_is_a_usage_error():
     assert completed.returncode == 2 and "no graded test matches" in completed.stderr
 
 
-def grade_one_function(module_file, tmp_path):
+def grade_one_function(module_file, tmp_path, *extra):
     """Grade ``tests/<kind>/<function>/<name>.py`` as that function's module,
     the reference standing in for the rest, with that function's tests only."""
     function = module_file.parent.name
@@ -124,6 +126,7 @@ def grade_one_function(module_file, tmp_path):
         f"{GRADED_FUNCTIONS[function]}={module_file}",
         "--function",
         function,
+        *extra,
         tmp_path=tmp_path,
     )
     assert summary["tests"], f"no test of {function} ran"
@@ -139,19 +142,53 @@ MUTANTS = sorted((REPO_ROOT / "tests" / "mutants").glob("*/*.py"))
 ALTERNATIVES = sorted((REPO_ROOT / "tests" / "alternatives").glob("*/*.py"))
 
 
+def declared_mistake(path):
+    """A mutant's ``MISTAKE = "<id>"``: the diagnosis it must get (None: none is promised)."""
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "MISTAKE" for t in node.targets):
+            return ast.literal_eval(node.value)
+    raise AssertionError(f"{path.relative_to(REPO_ROOT)} declares no MISTAKE (its diagnosis, or None)")
+
+
+DIAGNOSIS_FLOOR = 0.9  # of the mutants, named by their diagnosis (issue 13)
+
+
 @pytest.mark.parametrize("mutant", MUTANTS, ids=ids(MUTANTS))
-def test_wrong_submission_loses_points(mutant, tmp_path):
+def test_wrong_submission_loses_points_and_gets_its_diagnosis(mutant, tmp_path):
     summary = grade_one_function(mutant, tmp_path)
     assert summary["score"] < summary["max_score"], (
         f"{mutant.relative_to(REPO_ROOT)} ({mutant.read_text().splitlines()[0]}) keeps full marks"
     )
+    expected = declared_mistake(mutant)
+    if expected is None:
+        return
+    function = mutant.parent.name
+    found = summary.get("extra_data", {}).get("diagnoses", {}).get(function)
+    assert found and found["id"] == expected, f"{mutant.relative_to(REPO_ROOT)}: diagnosed {found}, not {expected}"
+    # The line reaches the student: in the marks per function, and first in each explained test's feedback.
+    assert any(
+        line.startswith(f"- `{function}`:") and found["message"] in line for line in summary["output"].splitlines()
+    )
+    assert found["explains"] >= 1
+    if found["id"] not in ONE_LINE_ALREADY:  # those tests say it in their own line already
+        explained = [t for t in summary["tests"] if t["output"].startswith(f"diagnosis: {found['message']}")]
+        assert len(explained) == found["explains"]
+
+
+def test_at_least_nine_in_ten_mutants_are_named_by_their_diagnosis():
+    declared = [path for path in MUTANTS if declared_mistake(path) is not None]
+    rate = len(declared) / len(MUTANTS)
+    print(f"diagnosis promised (and checked, one test each) for {len(declared)} of {len(MUTANTS)} mutants: {rate:.0%}")
+    assert rate >= DIAGNOSIS_FLOOR, f"only {len(declared)} of {len(MUTANTS)} mutants have a diagnosis ({rate:.0%})"
 
 
 @pytest.mark.parametrize("variant", ALTERNATIVES, ids=ids(ALTERNATIVES))
-def test_other_correct_submission_gets_full_marks(variant, tmp_path):
-    summary = grade_one_function(variant, tmp_path)
+def test_other_correct_submission_gets_full_marks_and_no_diagnosis(variant, tmp_path):
+    # --diagnose-always: the catalogue is tried on this full-marks run as if every test had failed.
+    summary = grade_one_function(variant, tmp_path, "--diagnose-always")
     failed = [f"{t['name']}: {t['output']}" for t in summary["tests"] if t["status"] != "passed"]
     assert not failed, f"{variant.name} loses points:\n" + "\n".join(failed)
+    assert not summary.get("extra_data", {}).get("diagnoses"), f"{variant.name} is diagnosed: {summary['extra_data']}"
 
 
 def test_every_graded_function_has_wrong_and_alternative_submissions():
@@ -171,7 +208,10 @@ def test_hidden_tests_run_when_grading_and_withhold_their_details(tmp_path):
     )
     hidden = [t for t in summary["tests"] if t["visibility"] == "after_published"]
     assert hidden and all(t["status"] == "failed" and "_hidden_" in t["name"] for t in hidden)
-    assert all("hidden test: details withheld" in t["output"] and "\n" not in t["output"] for t in hidden)
+    for test in hidden:  # one line, after the diagnosis (values-free) when there is one
+        lines = test["output"].splitlines()
+        assert lines[-1].endswith("(hidden test: details withheld)") and len(lines) <= 2, test["output"]
+        assert len(lines) == 1 or lines[0].startswith("diagnosis: "), test["output"]
 
 
 def test_junit_xml_is_written(tmp_path):

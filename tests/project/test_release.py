@@ -45,7 +45,15 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
         "book/pca.md",
     ):
         assert (release_dir / needed).exists(), needed
-    for absent in ("solutions", "tests/mutants", "tests/alternatives", "tests/project", "tests/hidden", ".git"):
+    for absent in (
+        "solutions",
+        "grading/mistakes",
+        "tests/mutants",
+        "tests/alternatives",
+        "tests/project",
+        "tests/hidden",
+        ".git",
+    ):
         assert not (release_dir / absent).exists(), absent
     for module in EXERCISE_MODULES:
         assert (release_dir / "pcl_course" / f"{module}.py").read_bytes() == (

@@ -5,6 +5,8 @@ import numpy as np
 from solutions.normals import *  # noqa: F401,F403
 from solutions.normals import estimate_normals as _reference
 
+MISTAKE = "no_nan_for_small_neighbourhoods"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def estimate_normals(points, k=30, radius=None, viewpoint=None):
     normals, curvature = _reference(points, k, radius, viewpoint)

@@ -6,6 +6,8 @@ import open3d as o3d
 from solutions.normals import *  # noqa: F401,F403
 from solutions.normals import estimate_normals as _reference
 
+MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def estimate_normals(points, k=30, radius=None, viewpoint=None):
     if radius is not None:

@@ -5,6 +5,8 @@ import importlib
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import farthest_point_sampling as _reference
 
+MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/mistakes/)
+
 backend = importlib.import_module("open" + "3d")
 
 

@@ -5,6 +5,8 @@ import numpy as np
 from solutions.pca import *  # noqa: F401,F403
 from solutions.pca import kernel_matrix as _reference
 
+MISTAKE = "polynomial_without_one"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def kernel_matrix(x, y, kernel="gaussian", beta=1.0, degree=2):
     if kernel == "polynomial":

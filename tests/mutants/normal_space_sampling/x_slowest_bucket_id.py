@@ -5,6 +5,8 @@ import numpy as np
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import normal_space_sampling as _reference
 
+MISTAKE = "x_slowest_bucket_id"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def normal_space_sampling(normals, n_samples, n_bins=4, rng=None):
     _reference(normals, n_samples, n_bins, rng)  # validation only

@@ -5,6 +5,8 @@ from sklearn.decomposition import PCA
 
 from solutions.pca import *  # noqa: F401,F403
 
+MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def pca(points, correlation=False, sort=True):
     x = np.asarray(points, dtype=float)

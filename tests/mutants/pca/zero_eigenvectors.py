@@ -5,6 +5,8 @@ import numpy as np
 from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
 from solutions.pca import pca as _reference  # noqa: F401
 
+MISTAKE = "zero_eigenvectors"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def pca(points, correlation=False, sort=True):
     eigenvalues, eigenvectors = _reference(points, correlation=correlation, sort=sort)

@@ -6,6 +6,8 @@ from scipy.spatial import cKDTree
 from solutions.filters import *  # noqa: F401,F403
 from solutions.filters import statistical_outlier_removal as _reference
 
+MISTAKE = "sum_not_mean"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def statistical_outlier_removal(points, k, std_ratio):
     _reference(points, k, std_ratio)  # validation only

@@ -5,6 +5,8 @@ import numpy as np
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import voxel_grid_downsample as _reference
 
+MISTAKE = "int64_index"  # the diagnosis this mistake must get (grading/mistakes/)
+
 
 def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
     _reference(points, voxel_size, method, rng)  # validation (and the empty case) only

@@ -1,0 +1,543 @@
+"""One line that names the mistake behind a function's lost points.
+
+While the tests run, every call of a graded function is recorded
+(:class:`Call`: its arguments, copied before the call, its answer or its
+exception, and whether it changed an argument in place). When a function
+has lost points, :func:`diagnose` looks at all of its calls together, in
+this order, and stops at the first finding:
+
+1. a cause that makes every test fail the same way: the stub, a forbidden
+   API, one exception raised by every call (a missing import);
+2. an exception raised only on clouds with extra columns, or a signature
+   that is not the contract's (a wrong argument order);
+3. an input modified in place; answers of the wrong type or dtype;
+4. a known mistake of that function (the catalogue in
+   :mod:`grading.mistakes`, which ships with the instructors' grader only):
+   each mistake predicts, grader-side, what it would answer on the same
+   inputs, and is named when the student's answers equal its predictions on
+   every call where it differs from the right answer;
+5. every failed test expecting a ``ValueError`` the function did not raise;
+   or every failed test breaking one and the same rule.
+
+Where nothing matches, there is no diagnosis: the grader says nothing rather
+than guess. A diagnosis never quotes a value of a hidden test's inputs.
+"""
+
+import ast
+import copy
+import inspect
+import os
+import sys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from grading import GRADED_FUNCTIONS, config
+
+# Kinds of test failure, recorded by the plugin for each failed test.
+NOT_IMPLEMENTED, FORBIDDEN, REFUSED, SANDBOX = "not implemented", "forbidden", "refused", "sandbox"
+DID_NOT_RAISE, CHECK, ASSERTION, ERROR, TIMEOUT = "did not raise", "check", "assertion", "error", "timeout"
+
+
+# Diagnoses whose tests already say it in one line (the stub, a forbidden API), and causes
+# that fail every test the same way: these tests show the diagnosis alone.
+ONE_LINE_ALREADY = ("not_implemented", "forbidden_api")
+ONE_CAUSE = ("same_error_everywhere",)
+
+
+@dataclass
+class Call:
+    """One call of a graded function during a test."""
+
+    test: str
+    args: tuple
+    kwargs: dict
+    result: object = None
+    error_type: str = None
+    error: str = None  # the exception's first line
+    where: str = None  # file:line in the submission, when known
+    modified: bool = False
+    kept: bool = True  # False: the arguments were too large to keep
+
+    @property
+    def raised(self):
+        return self.error_type is not None
+
+
+@dataclass
+class Outcome:
+    """How one test ended: passed, or the kind of failure and the broken rule."""
+
+    passed: bool
+    kind: str = None
+    rule: str = None
+    interface: bool = False  # the test checks shapes, dtypes, errors or in-place changes only
+
+
+@dataclass(frozen=True)
+class Diagnosis:
+    """What :func:`diagnose` found: an ``id`` (for the project's own checks),
+    the line for the student, and the failed tests it explains."""
+
+    id: str
+    message: str
+    explains: tuple = field(default_factory=tuple)
+
+
+# -- recording -----------------------------------------------------------------------
+
+
+def _size(value):
+    if isinstance(value, np.ndarray):
+        return value.size
+    if isinstance(value, (list, tuple)):
+        return sum(_size(v) for v in value)
+    if isinstance(value, dict):
+        return sum(_size(v) for v in value.values())
+    return 1
+
+
+def snapshot(args, kwargs):
+    """Copies of a call's arguments, or None when they are too large to keep."""
+    if _size(args) + _size(kwargs) > config.DIAGNOSIS_MAX_VALUES:
+        return None
+    try:
+        return copy.deepcopy(args), copy.deepcopy(kwargs)
+    except Exception:  # an argument that cannot be copied: not recorded
+        return None
+
+
+def changed(before, after):
+    """Whether any array argument differs from its copy taken before the call."""
+    for old, new in zip(before, after):
+        if isinstance(old, np.ndarray) and isinstance(new, np.ndarray):
+            if old.shape != new.shape or not np.array_equal(old, new, equal_nan=old.dtype.kind in "fc"):
+                return True
+    return False
+
+
+# -- the contract's signatures -------------------------------------------------------
+
+
+def contract_signature(function):
+    """The stub's signature of ``function`` (the course's ``pcl_course``)."""
+    import importlib
+
+    module = importlib.import_module(f"pcl_course.{GRADED_FUNCTIONS[function]}")
+    return inspect.signature(getattr(module, function))
+
+
+def bind(function, call):
+    """The call's arguments by parameter name, defaults filled in (None if they do not bind)."""
+    try:
+        bound = contract_signature(function).bind(*call.args, **call.kwargs)
+    except TypeError:
+        return None
+    bound.apply_defaults()
+    return dict(bound.arguments)
+
+
+def _parameters_in_source(source, function):
+    """The parameter names of ``def function(...)`` in a module's source, or None."""
+    try:
+        tree = ast.parse(source)
+    except SyntaxError:
+        return None
+    for node in tree.body:
+        if isinstance(node, ast.FunctionDef) and node.name == function:
+            arguments = node.args
+            return [a.arg for a in arguments.posonlyargs + arguments.args + arguments.kwonlyargs]
+    return None
+
+
+# -- the generic findings ---------------------------------------------------------------
+
+
+def _plural(n, word):
+    return f"{n} {word}" if n == 1 else f"{n} {word}s"
+
+
+def _explicit(function, calls, outcomes, failed, context):
+    kinds = {outcomes[t].kind for t in failed}
+    if kinds == {NOT_IMPLEMENTED}:
+        return Diagnosis("not_implemented", "not implemented yet (the stub raises NotImplementedError)", failed)
+    if kinds == {FORBIDDEN}:
+        return Diagnosis(
+            "forbidden_api",
+            f"{GRADED_FUNCTIONS[function]}.py uses a forbidden package (see the tests' message): "
+            "write your own code with NumPy and SciPy",
+            failed,
+        )
+    return None
+
+
+_IMPORT_FIXES = {
+    "np": "import numpy as np",
+    "math": "import math",
+    "cKDTree": "from scipy.spatial import cKDTree",
+    "scipy": "import scipy",
+    "as_points": "from pcl_course.validation import as_points",
+    "as_array": "from pcl_course.validation import as_array",
+}
+
+
+def _same_error_everywhere(function, calls, outcomes, failed, context):
+    if len(calls) < 2 or not all(c.raised for c in calls):
+        return None
+    kinds = {(c.error_type, c.where) for c in calls}
+    if len(kinds) != 1:
+        return None
+    error_type, where = kinds.pop()
+    messages = {c.error for c in calls}
+    shown = f": {messages.pop()}" if len(messages) == 1 else ""  # a message that varies may quote inputs
+    place = f" at {where}" if where else ""
+    message = f"every call raised {error_type}{shown}{place}"
+    if error_type == "NameError" and shown:
+        name = shown.split("'")[1] if shown.count("'") >= 2 else ""
+        if name in _IMPORT_FIXES:
+            message += f": add `{_IMPORT_FIXES[name]}` at the top of {GRADED_FUNCTIONS[function]}.py"
+    explained = tuple(t for t in failed if any(c.test == t for c in calls))
+    return Diagnosis("same_error_everywhere", message, explained)
+
+
+def _columns(call, function):
+    arguments = bind(function, call)
+    points = arguments.get("points") if arguments else None
+    if isinstance(points, np.ndarray) and points.ndim == 2:
+        return points.shape[1]
+    return None
+
+
+def _not_a_validation_error(call):
+    """An exception of the code's own (unpacking three values, broadcasting), not a ValueError it meant."""
+    if call.error_type != "ValueError":
+        return True
+    return any(word in (call.error or "") for word in ("unpack", "broadcast", "shape", "could not"))
+
+
+def _rows(call, function):
+    arguments = bind(function, call)
+    points = arguments.get("points") if arguments else None
+    return len(points) if isinstance(points, np.ndarray) and points.ndim == 2 else 0
+
+
+def _extra_columns(function, calls, outcomes, failed, context):
+    if "points" not in contract_signature(function).parameters:
+        return None
+    wide = [c for c in calls if c.kept and (_columns(c, function) or 0) > 3 and _rows(c, function)]
+    narrow = [c for c in calls if c.kept and _columns(c, function) == 3]
+    crashed = [c for c in wide if c.raised and _not_a_validation_error(c)]
+    if not wide or len(crashed) != len(wide) or not narrow or all(c.raised for c in narrow):
+        return None
+    error_type = crashed[0].error_type
+    explained = tuple(t for t in failed if any(c.test == t for c in crashed))
+    return Diagnosis(
+        "extra_columns",
+        f"your code raises {error_type} on clouds with more than 3 columns and works on 3: the contract's "
+        "points may be (N, D) with D >= 3, whose first three columns are x, y, z; take points[:, :3] for the "
+        "coordinates and let the extra columns travel with their row",
+        explained,
+    )
+
+
+def _signature(function, calls, outcomes, failed, context):
+    source = context.get("sources", {}).get(GRADED_FUNCTIONS[function])
+    if source is None:
+        return None
+    theirs = _parameters_in_source(source, function)
+    ours = list(contract_signature(function).parameters)
+    if theirs is None or theirs == ours or theirs[: len(ours)] == ours:
+        return None
+    explained = tuple(t for t in failed if outcomes[t].kind in (ERROR, SANDBOX))
+    if not explained:
+        return None
+    return Diagnosis(
+        "signature",
+        f"your {function}({', '.join(theirs)}) does not take the contract's parameters "
+        f"({', '.join(ours)}) in this order: the tests pass them by position and by these names",
+        explained,
+    )
+
+
+def _modified_input(function, calls, outcomes, failed, context):
+    modified = [c for c in calls if c.modified]
+    if not modified:
+        return None
+    explained = tuple(t for t in failed if any(c.test == t for c in modified))
+    return Diagnosis(
+        "modifies_input",
+        f"{function} changed its input array in place ({_plural(len(modified), 'call')}): work on a copy "
+        "(np.array(points, dtype=float) copies; points -= ... does not)",
+        explained or tuple(failed),
+    )
+
+
+def _kind_of(value):
+    if isinstance(value, np.ndarray):
+        return "complex" if value.dtype.kind == "c" else str(value.dtype)
+    if isinstance(value, (list, tuple)):
+        return type(value).__name__
+    return None
+
+
+def _result_type(function, calls, outcomes, failed, context):
+    model = context.get("model")
+    expected = getattr(model, "output_dtypes", None)
+    if not expected:
+        return None
+    answered = [c for c in calls if not c.raised]
+    for call in answered:
+        parts = call.result if isinstance(call.result, tuple) and len(expected) > 1 else (call.result,)
+        for part, want in zip(parts, expected):
+            if want is None:
+                continue
+            kind = _kind_of(part)
+            if kind in ("list", "tuple"):
+                return Diagnosis(
+                    "returns_list",
+                    f"{function} returns a Python {kind}: return a numpy array ({want}), e.g. np.asarray(...)",
+                    tuple(failed),
+                )
+            if kind == "complex":
+                return Diagnosis(
+                    "complex",
+                    f"{function} returns complex numbers (np.linalg.eig or scipy.linalg.eig): the matrix is "
+                    "symmetric, so use np.linalg.eigh, whose eigenvalues and eigenvectors are real",
+                    tuple(failed),
+                )
+            if kind is not None and kind != want:
+                return Diagnosis(
+                    "dtype", f"{function} returns {kind} arrays: the contract's dtype here is {want}", tuple(failed)
+                )
+    return None
+
+
+def _did_not_raise(function, calls, outcomes, failed, context):
+    """Every failed test is an input check that the function missed: it returned, or raised
+    something other than a ValueError that names the argument."""
+
+    def missed_a_check(test):
+        outcome = outcomes[test]
+        if outcome.kind == DID_NOT_RAISE:
+            return True
+        return outcome.interface and any(c.test == test and c.raised for c in calls)
+
+    if failed and all(missed_a_check(t) for t in failed):
+        return Diagnosis(
+            "did_not_raise",
+            f"{function} does not check its input: a bad argument must raise ValueError naming it (e.g. "
+            "'points must be 2-D'); pcl_course.validation's as_points, check_positive, ... do it",
+            tuple(failed),
+        )
+    return None
+
+
+def _one_rule(function, calls, outcomes, failed, context):
+    rules = {outcomes[t].rule for t in failed}
+    if len(failed) >= 2 and len(rules) == 1 and None not in rules and all(outcomes[t].kind == CHECK for t in failed):
+        return Diagnosis("one_rule", f"every failed test breaks one rule: {rules.pop()}", tuple(failed))
+    return None
+
+
+# -- the catalogue of known mistakes ------------------------------------------------------
+
+
+def same(a, b, rtol=1e-6, atol=1e-8):
+    """Whether two answers are equal: arrays (NaN equal to NaN), numbers, tuples, dicts."""
+    if isinstance(a, tuple) or isinstance(b, tuple):
+        return isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b) and all(map(same, a, b))
+    if isinstance(a, dict) or isinstance(b, dict):
+        return isinstance(a, dict) and isinstance(b, dict) and set(a) == set(b) and all(same(a[k], b[k]) for k in a)
+    try:
+        a, b = np.asarray(a), np.asarray(b)
+    except Exception:
+        return False
+    if a.shape != b.shape:
+        return False
+    if a.dtype.kind in "biu" and b.dtype.kind in "biu":
+        return bool(np.array_equal(a, b))
+    try:
+        return bool(np.allclose(a.astype(float), b.astype(float), rtol=rtol, atol=atol, equal_nan=True))
+    except (TypeError, ValueError):
+        return False
+
+
+RANDOM = object()  # a truth that cannot be predicted (a random method): any mistake that applies differs
+
+
+@dataclass(frozen=True)
+class Raised:
+    """An answer that is an exception (its type's name): what a call raised, or what a mistake raises."""
+
+    error_type: str
+
+
+class Variants(tuple):
+    """Several answers a mistake may give (ways of writing it that round differently)."""
+
+
+CHANCE_LIMIT = 1e-3  # a test whose answers a right random method gives this often is no evidence
+
+
+def _fingerprint(arguments):
+    """A hashable summary of a call's arguments (arrays by content, generators by state)."""
+    parts = []
+    for name, value in sorted(arguments.items()):
+        if isinstance(value, np.ndarray):
+            parts.append((name, value.shape, value.dtype.str, value.tobytes()))
+        elif isinstance(value, np.random.Generator):
+            parts.append((name, repr(value.bit_generator.state)))
+        else:
+            parts.append((name, repr(value)))
+    return tuple(parts)
+
+
+def _chance(predicted):
+    """The chance that a right answer equals this prediction (0 for a deterministic function's)."""
+    if isinstance(predicted, Variants):
+        return max((_chance(p) for p in predicted), default=0.0)
+    chance = getattr(predicted, "chance", None)
+    return float(chance()) if callable(chance) else 0.0
+
+
+def _matches(compare, answer, predicted, arguments):
+    if isinstance(predicted, Variants):
+        return any(_matches(compare, answer, p, arguments) for p in predicted)
+    if isinstance(answer, Raised) or isinstance(predicted, Raised):
+        return (
+            isinstance(answer, Raised) and isinstance(predicted, Raised) and answer.error_type == predicted.error_type
+        )
+    return compare(answer, predicted, arguments)
+
+
+def _debug(function, mistake, why, test):
+    if os.environ.get("PCL_DIAGNOSIS_DEBUG"):
+        print(f"diagnosis of {function}: not {mistake}: {why} in {test}", file=sys.stderr)
+
+
+def _known_mistake(function, calls, outcomes, failed, context):
+    model = context.get("model")
+    if model is None:
+        return None
+    kept = [(c, bind(function, c)) for c in calls if c.kept]
+    kept = [(c, arguments) for c, arguments in kept if arguments is not None]
+    truths = {}
+    for call, arguments in kept:
+        try:
+            truths[id(call)] = model.truth(**copy.deepcopy(arguments))
+        except Exception:  # an input the contract rejects: nothing to compare
+            truths[id(call)] = None
+    best, best_key = None, None
+    for mistake in model.mistakes:
+        matched, contradicted, luck, seen = set(), set(), {}, {}
+        evidence, absent = 0, 0  # calls the mistake predicts; calls where it differs and the answer is right
+        compare = mistake.same or model.same
+        rejected = False
+        for call, arguments in kept:
+            truth = truths[id(call)]
+            if truth is None:
+                continue
+            try:
+                predicted = mistake.predict(**copy.deepcopy(arguments))
+            except Exception:
+                predicted = None
+            if isinstance(predicted, Variants) and truth is not RANDOM:
+                # Only the ways of making the mistake that change the answer are evidence.
+                predicted = Variants(v for v in predicted if not _matches(compare, truth, v, arguments)) or None
+            if predicted is None or (truth is not RANDOM and _matches(compare, truth, predicted, arguments)):
+                # The mistake gives the right answer here, or does not apply: no evidence, unless
+                # the mistake is exclusive (then the answer must be right here).
+                if getattr(mistake, "exclusive", False) and truth is not RANDOM:
+                    if call.raised or not model.same(call.result, truth, arguments):
+                        _debug(function, mistake.id, "wrong where the mistake is right", call.test)
+                        rejected = True
+                        break
+                continue
+            answer = Raised(call.error_type) if call.raised else call.result
+            if _matches(compare, answer, predicted, arguments):
+                matched.add(call.test)
+                evidence += 1
+                # A random method's right answer may equal the mistake's by chance: a test is
+                # evidence only when that chance, over all of its calls, is small.
+                # Calls with the same arguments (the same seed) are one draw, not several.
+                key = _fingerprint(arguments)
+                if key not in seen.setdefault(call.test, set()):
+                    seen[call.test].add(key)
+                    luck[call.test] = luck.get(call.test, 1.0) * _chance(predicted)
+            elif (
+                truth is not RANDOM
+                and not call.raised
+                and _chance(predicted) == 0.0  # a random method's mismatch is evidence against
+                and model.same(call.result, truth, arguments)
+            ):
+                absent += 1  # the answer is right here: the mistake is not on this code path
+            elif call.raised and call.error_type == "ValueError":
+                pass  # a check of the student's own that the model lacks: no evidence either way
+            else:
+                _debug(function, mistake.id, "does not match its prediction", call.test)
+                contradicted.add(call.test)
+        if rejected:
+            continue
+        # A test is explained when the mistake predicts its answers and nothing contradicts it
+        # there; the mistake is named when it explains more tests than contradict it.
+        explained = tuple(
+            t for t in failed if t in matched and t not in contradicted and luck.get(t, 0.0) < CHANCE_LIMIT
+        )
+        _debug(function, mistake.id, f"explains {len(explained)}, contradicted by {len(contradicted)}", "all")
+        if explained and len(explained) > len(contradicted):
+            key = (len(explained), -len(contradicted), -absent, evidence)
+            if best_key is None or key > best_key:
+                best, best_key = Diagnosis(mistake.id, mistake.message, explained), key
+    return best
+
+
+FINDINGS = (
+    _explicit,
+    _same_error_everywhere,
+    _signature,
+    _extra_columns,
+    _modified_input,
+    _result_type,
+    _known_mistake,
+    _did_not_raise,
+    _one_rule,
+)
+
+
+def diagnose(function, calls, outcomes, model=None, sources=None):
+    """The diagnosis of one graded function's lost points, or None.
+
+    Parameters
+    ----------
+    function : str
+        The graded function.
+    calls : list of Call
+        Its recorded calls, over all of its tests.
+    outcomes : dict
+        Test id -> :class:`Outcome`, for the function's tests.
+    model : object, optional
+        The function's catalogue entry (:mod:`grading.mistakes`): ``truth``,
+        ``same``, ``mistakes`` and ``output_dtypes``.
+    sources : dict, optional
+        Exercise module name -> the submission's source text (for the
+        signature check; read, never run).
+    """
+    failed = tuple(t for t, o in outcomes.items() if not o.passed)
+    if not failed:
+        return None
+    context = {"model": model, "sources": sources or {}}
+    for finding in FINDINGS:
+        found = finding(function, calls, outcomes, failed, context)
+        if found is not None:
+            return found
+    return None
+
+
+def explained_line(diagnosis, failed_count):
+    """The diagnosis as the line at the top of a function's feedback."""
+    explains = len(diagnosis.explains)
+    if explains and failed_count > 1:
+        tail = f" (explains {explains} of {failed_count} failed tests)"
+    else:
+        tail = ""
+    return f"{diagnosis.message}{tail}"

@@ -1,0 +1,59 @@
+"""The catalogue of known mistakes, one module per exercise module.
+
+For each graded function a :class:`Model`: how to compute the right answer
+grader-side (``truth``, written independently of ``solutions/``, from
+NumPy, SciPy and the contract's definitions), how two answers compare
+(``same``: the freedoms the contract leaves, such as eigenvector signs),
+the dtypes of its outputs, and its known :class:`Mistake` s, each with what
+it would answer on the same inputs and the line that names it.
+
+The mistakes come from ``tests/mutants`` (each mutant names its own with
+``MISTAKE = "<id>"``), from real students' code and from the book's
+pitfalls. This package holds working code for every exercise, so it ships
+with the instructors' grader (the course repository, the Gradescope archive)
+and never with the student release; the grader runs without it.
+"""
+
+from dataclasses import dataclass, field
+
+from grading.diagnosis import RANDOM, Raised, Variants, same  # noqa: F401  (re-exported for the catalogue modules)
+
+
+@dataclass(frozen=True)
+class Mistake:
+    """A known mistake: ``predict(**arguments)`` is its answer (None where it does not apply).
+
+    ``exclusive``: the mistake is named only if the answers are right
+    wherever it does not apply (for mistakes known only by the answers they
+    get wrong, such as "wrong far from the origin").
+    """
+
+    id: str
+    message: str
+    predict: object
+    same: object = None
+    exclusive: bool = False
+
+
+def _default_same(a, b, arguments):
+    return same(a, b)
+
+
+@dataclass(frozen=True)
+class Model:
+    """A graded function in the catalogue (see the module docstring)."""
+
+    truth: object
+    mistakes: tuple = field(default_factory=tuple)
+    same: object = _default_same
+    output_dtypes: tuple = None
+
+
+def model(function):
+    """The catalogue entry of ``function``, or None."""
+    from grading.mistakes import downsampling, filters, metrics, normals, pca
+
+    for module in (pca, normals, downsampling, filters, metrics):
+        if function in module.MODELS:
+            return module.MODELS[function]
+    return None

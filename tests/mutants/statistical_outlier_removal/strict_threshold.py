@@ -1,0 +1,17 @@
+"""Keeps where d_i < mu + std_ratio * sigma (strict): an evenly spaced cloud (sigma = 0) loses every point."""
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from solutions.filters import *  # noqa: F401,F403
+from solutions.filters import statistical_outlier_removal as _reference
+
+MISTAKE = "strict_threshold"  # the diagnosis this mistake must get (grading/mistakes/)
+
+
+def statistical_outlier_removal(points, k, std_ratio):
+    _reference(points, k, std_ratio)  # validation only
+    xyz = np.asarray(points, float)[:, :3]
+    d, _ = cKDTree(xyz).query(xyz, k=k + 1)
+    m = d[:, 1:].mean(axis=1)
+    return m < m.mean() + std_ratio * m.std(ddof=1)
