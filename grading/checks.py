@@ -68,7 +68,8 @@ def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
         rows = ""
         if actual.ndim == expected.ndim >= 1 and actual.shape[1:] == expected.shape[1:]:
             difference = actual.shape[0] - expected.shape[0]
-            rows = f" ({abs(difference)} {'more' if difference > 0 else 'fewer'} rows than expected)"
+            count = abs(difference)
+            rows = f" ({count} {'row' if count == 1 else 'rows'} {'more' if difference > 0 else 'fewer'} than expected)"
         raise CheckFailed(
             _with_hint(f"{name}: expected shape {expected.shape}, got {actual.shape}{rows}{note}", hint),
             rule=f"{name} has the wrong shape",
