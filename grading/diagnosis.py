@@ -41,7 +41,7 @@ DID_NOT_RAISE, CHECK, ASSERTION, ERROR, TIMEOUT = "did not raise", "check", "ass
 
 # Diagnoses whose tests already say it in one line (the stub, a forbidden API), and causes
 # that fail every test the same way: these tests show the diagnosis alone.
-ONE_LINE_ALREADY = ("not_implemented", "forbidden_api")
+ONE_LINE_ALREADY = ("not_implemented", "forbidden_api", "sandbox")
 ONE_CAUSE = ("same_error_everywhere",)
 
 
@@ -87,19 +87,20 @@ class Diagnosis:
 # -- recording -----------------------------------------------------------------------
 
 
-def _size(value):
+def size_of(value):
+    """How many values ``value`` holds (array entries, recursively), to bound what is kept."""
     if isinstance(value, np.ndarray):
         return value.size
     if isinstance(value, (list, tuple)):
-        return sum(_size(v) for v in value)
+        return sum(size_of(v) for v in value)
     if isinstance(value, dict):
-        return sum(_size(v) for v in value.values())
+        return sum(size_of(v) for v in value.values())
     return 1
 
 
 def snapshot(args, kwargs):
     """Copies of a call's arguments, or None when they are too large to keep."""
-    if _size(args) + _size(kwargs) > config.DIAGNOSIS_MAX_VALUES:
+    if size_of(args) + size_of(kwargs) > config.DIAGNOSIS_MAX_VALUES:
         return None
     try:
         return copy.deepcopy(args), copy.deepcopy(kwargs)
@@ -161,6 +162,11 @@ def _explicit(function, calls, outcomes, failed, context):
     kinds = {outcomes[t].kind for t in failed}
     if kinds == {NOT_IMPLEMENTED}:
         return Diagnosis("not_implemented", "not implemented yet (the stub raises NotImplementedError)", failed)
+    if kinds <= {REFUSED, SANDBOX} and len({c.error for c in calls}) <= 1 and all(c.raised for c in calls):
+        # Refused at staging, or a module that cannot be imported: each test already says it in one line.
+        errors = {c.error for c in calls}
+        why = errors.pop().removeprefix("raised SandboxError: ") if errors else "the submission was refused"
+        return Diagnosis("sandbox", f"every test failed the same way: {why}", failed)
     if kinds == {FORBIDDEN}:
         return Diagnosis(
             "forbidden_api",

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
-from grading.diagnosis import Call, changed, snapshot
+from grading.diagnosis import Call, changed, size_of, snapshot
 from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
 from grading.forbidden import scan_package
 
@@ -76,6 +76,7 @@ class Implementation:
         self.package = f"_graded_impl_{next(_counter)}"
         self._modules = {}
         self.last_call = None
+        self.sandboxed = sandbox
         self.current_test = None  # set by the plugin: the test under way
         self.calls = {}  # graded function -> [Call], for the diagnosis
         self.worker = None
@@ -170,7 +171,10 @@ class Implementation:
             finally:
                 if kept is not None:
                     call.modified = changed(kept[0], args) or changed(list(kept[1].values()), list(kwargs.values()))
-            call.result = copy.deepcopy(result) if kept is not None else None
+            if kept is not None and size_of(result) <= config.DIAGNOSIS_MAX_VALUES:
+                call.result = copy.deepcopy(result)
+            else:  # too large to keep: the call is not replayed by the diagnosis
+                call.kept, call.args, call.kwargs = False, (), {}
             return result
 
         graded_call.__name__ = name
@@ -180,7 +184,9 @@ class Implementation:
         """The text of the implementation's ``module.py`` (read, never run), or None."""
         if self.staged is not None:
             path = self.staged.package / f"{module}.py"
-        else:
+        elif self.sandboxed:
+            return None  # refused at staging: the student's own files are never read, links never followed
+        else:  # trusted code (the reference, the project's mutants)
             path = self.overrides.get(module, self.directory / f"{module}.py")
         try:
             return Path(path).read_text(encoding="utf-8", errors="replace")
