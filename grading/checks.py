@@ -98,9 +98,7 @@ def check_unit_columns_match(actual, expected, name, atol=1e-6, hint=""):
             f"{name}: column {i} is not the expected unit vector (up to sign): "
             f"|cos angle| = {dots[i]:.6f}, norm = {norms[i]:.6f}"
         )
-        if hint:
-            message += f"\n  hint: {hint}"
-        raise CheckFailed(message, rule=f"{name}: a column is not the expected unit vector")
+        raise CheckFailed(_with_hint(message, hint), rule=f"{name}: a column is not the expected unit vector")
 
 
 def check_finite(value, name, hint=""):
@@ -110,9 +108,7 @@ def check_finite(value, name, hint=""):
     if bad.size:
         index = tuple(int(i) for i in np.unravel_index(bad[0], value.shape))
         message = f"{name} must be finite, but {bad.size} of {value.size} values are not (first at {index})"
-        if hint:
-            message += f"\n  hint: {hint}"
-        raise CheckFailed(message, rule=f"{name} must be finite")
+        raise CheckFailed(_with_hint(message, hint), rule=f"{name} must be finite")
 
 
 def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
@@ -129,6 +125,4 @@ def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
             else f"columns {i} and {j} have dot product {gram[i, j]:.6g}"
         )
         message = f"{name} must have orthonormal columns, but {what}"
-        if hint:
-            message += f"\n  hint: {hint}"
-        raise CheckFailed(message, rule=f"{name} must have orthonormal columns")
+        raise CheckFailed(_with_hint(message, hint), rule=f"{name} must have orthonormal columns")

@@ -206,12 +206,11 @@ def _same_error_everywhere(function, calls, outcomes, failed, context):
     return Diagnosis("same_error_everywhere", message, explained)
 
 
-def _columns(call, function):
-    arguments = bind(function, call)
+def _points(call, function):
+    """The call's ``points`` argument, when it is a 2-D array."""
+    arguments = bind(function, call) if call.kept else None
     points = arguments.get("points") if arguments else None
-    if isinstance(points, np.ndarray) and points.ndim == 2:
-        return points.shape[1]
-    return None
+    return points if isinstance(points, np.ndarray) and points.ndim == 2 else None
 
 
 def _not_a_validation_error(call):
@@ -221,17 +220,12 @@ def _not_a_validation_error(call):
     return any(word in (call.error or "") for word in ("unpack", "broadcast", "shape", "could not"))
 
 
-def _rows(call, function):
-    arguments = bind(function, call)
-    points = arguments.get("points") if arguments else None
-    return len(points) if isinstance(points, np.ndarray) and points.ndim == 2 else 0
-
-
 def _extra_columns(function, calls, outcomes, failed, context):
     if "points" not in contract_signature(function).parameters:
         return None
-    wide = [c for c in calls if c.kept and (_columns(c, function) or 0) > 3 and _rows(c, function)]
-    narrow = [c for c in calls if c.kept and _columns(c, function) == 3]
+    shapes = [(c, _points(c, function)) for c in calls]
+    wide = [c for c, points in shapes if points is not None and points.shape[1] > 3 and len(points)]
+    narrow = [c for c, points in shapes if points is not None and points.shape[1] == 3]
     crashed = [c for c in wide if c.raised and _not_a_validation_error(c)]
     if not wide or len(crashed) != len(wide) or not narrow or all(c.raised for c in narrow):
         return None

@@ -71,7 +71,7 @@ def _course_copy(into):
     )
 
 
-def _zip_entry(path, name):
+def _zip_entry(name):
     info = zipfile.ZipInfo(name, date_time=ZIP_DATE)
     executable = name in SCRIPTS
     info.external_attr = ((0o755 if executable else 0o644) | stat.S_IFREG) << 16
@@ -107,7 +107,7 @@ def build_archive(out_zip):
         with zipfile.ZipFile(temporary, "w") as archive:
             for path in sorted(p for p in root.rglob("*") if p.is_file()):
                 name = path.relative_to(root).as_posix()
-                archive.writestr(_zip_entry(path, name), path.read_bytes())
+                archive.writestr(_zip_entry(name), path.read_bytes())
         os.replace(temporary, out_zip)
     return []
 

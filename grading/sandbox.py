@@ -586,10 +586,12 @@ class Worker:
     # -- process management ---------------------------------------------------
 
     def _command(self):
-        # Without a network namespace the seccomp filter is the only wall: required.
-        network = (
-            "optional" if self.isolation.level == BUBBLEWRAP else "required" if self.uid is not None else "optional"
-        )
+        # Bubblewrap's empty network namespace is the wall (its sandbox has no ldconfig for
+        # libseccomp anyway); without one the seccomp filter is, required as a dedicated uid.
+        if self.isolation.level == BUBBLEWRAP:
+            network = "namespace"
+        else:
+            network = "required" if self.uid is not None else "optional"
         tail = [",".join(config.FORBIDDEN_PACKAGES), network]
         if self.isolation.level == BUBBLEWRAP:
             return _bubblewrap_command(self.staged_root, tail), {}

@@ -29,6 +29,7 @@ from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 from copydetect import CodeFingerprint, compare_files
 from copydetect.utils import highlight_overlap
 
@@ -70,8 +71,6 @@ class Pair:
 
 
 def _boilerplate_hashes(stubs):
-    import numpy as np
-
     hashes = []
     for path in sorted(Path(stubs).glob("*.py")):
         hashes.extend(CodeFingerprint(str(path), NOISE_TOKENS, 1).hashes)  # a set of k-gram hashes
@@ -87,8 +86,6 @@ def _fingerprints(module, texts, boilerplate):
 
 def _common_hashes(module, texts, boilerplate):
     """The boilerplate plus every fingerprint too common in the class to mean copying."""
-    import numpy as np
-
     counts = Counter(
         h for fingerprint in _fingerprints(module, texts, boilerplate).values() for h in fingerprint.hashes
     )

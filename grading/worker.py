@@ -16,17 +16,18 @@ The answer also names every argument the call modified in place, with its
 new value, so that the grader can apply the same change to its own copy:
 a sandboxed call then behaves as an in-process one.
 
-Before it imports anything of the submission's, the worker closes the
-network with a seccomp filter (:func:`close_network`): every ``socket()``
-and ``io_uring_setup()`` fails with ``EACCES``. Under bubblewrap the network
-namespace has no network anyway; as a dedicated uid without namespaces (a
-Docker container) the filter is the wall, and the worker refuses to run
-without it.
+Outside bubblewrap, before it imports anything of the submission's, the
+worker closes the network with a seccomp filter (:func:`close_network`):
+every ``socket()`` and ``io_uring_setup()`` fails with ``EACCES``. As a
+dedicated uid without namespaces (a Docker container) the filter is the
+wall, and the worker refuses to run without it; under bubblewrap the empty
+network namespace is.
 
 Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES NETWORK
 (FORBIDDEN_PACKAGES comma-separated, from grading.config; NETWORK is
 ``required`` or ``optional``: whether the worker may run when the filter
-cannot be installed), or python -I -S worker.py --check-network SITE_PACKAGES.
+cannot be installed, or ``namespace``: no filter, bubblewrap's network
+namespace is the wall), or python -I -S worker.py --check-network SITE_PACKAGES.
 """
 
 import errno
@@ -225,7 +226,9 @@ def main():
     sys.stdout = sys.stderr
     requests = sys.stdin.buffer
     sys.path[:] = [p for p in sys.path if p and os.path.isdir(p)] + [site_packages]
-    why_not = close_network()  # before the forbidden-import finder: pyseccomp is the grader's
+    # Before the forbidden-import finder: pyseccomp is the grader's. Under bubblewrap the
+    # network namespace is the wall already.
+    why_not = close_network() if network != "namespace" else None
     if why_not is not None and network == "required":
         protocol.send({"ready": False, "error": f"the network could not be closed: {why_not}"})
         return

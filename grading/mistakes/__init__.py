@@ -16,6 +16,8 @@ and never with the student release; the grader runs without it.
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from grading.diagnosis import RANDOM, Raised, Variants, same  # noqa: F401  (re-exported for the catalogue modules)
 
 
@@ -33,6 +35,19 @@ class Mistake:
     predict: object
     same: object = None
     exclusive: bool = False
+
+
+def valid_points(points, min_columns=1, max_columns=None, min_rows=0):
+    """A float copy of ``points`` if the contract accepts it as a cloud, else ValueError.
+
+    A truth raises where the contract does: such a call is then not compared.
+    """
+    data = np.array(points, dtype=float)
+    if data.ndim != 2 or data.shape[0] < min_rows or data.shape[1] < min_columns or not np.isfinite(data).all():
+        raise ValueError("not a valid cloud")
+    if max_columns is not None and data.shape[1] > max_columns:
+        raise ValueError("not a valid cloud")
+    return data
 
 
 def _default_same(a, b, arguments):

@@ -2,17 +2,10 @@
 
 import numpy as np
 
-from grading.mistakes import RANDOM, Mistake, Model, Variants, same
+from grading.mistakes import RANDOM, Mistake, Model, Variants, same, valid_points
 
 MAX_LOOPED_POINTS = 200_000  # the hash-table filter is replayed point by point up to this size
 MAX_FPS_WORK = 400_000_000  # points x samples replayed for farthest point sampling
-
-
-def _cloud(points, columns=3):
-    data = np.array(points, dtype=float)
-    if data.ndim != 2 or data.shape[1] < columns or not np.isfinite(data).all():
-        raise ValueError("not a cloud")
-    return data
 
 
 def _cells(xyz, voxel_size, origin="minimum"):
@@ -25,7 +18,7 @@ def _cells(xyz, voxel_size, origin="minimum"):
 
 def voxel_grid(points, voxel_size, method="centroid", rng=None, **changes):
     """The exact filter, with the contract's ordering unless ``changes`` say otherwise."""
-    data = _cloud(points)
+    data = valid_points(points, min_columns=3)
     if not voxel_size > 0:
         raise ValueError("voxel_size")
     if len(data) == 0:
@@ -197,7 +190,7 @@ VOXEL_GRID_DOWNSAMPLE = Model(
 
 
 def hash_filter(points, voxel_size, n_containers, method="centroid", rng=None, **changes):
-    data = _cloud(points)
+    data = valid_points(points, min_columns=3)
     if not voxel_size > 0 or int(n_containers) < 1:
         raise ValueError("voxel_size or n_containers")
     if len(data) > MAX_LOOPED_POINTS:
@@ -281,7 +274,7 @@ APPROXIMATE_VOXEL_DOWNSAMPLE = Model(
 
 
 def fps(points, n_samples, start_index=0, **changes):
-    data = _cloud(points)
+    data = valid_points(points, min_columns=3)
     n_samples, start_index = int(n_samples), int(start_index)
     if not 0 <= n_samples <= len(data) or not 0 <= start_index < max(len(data), 1):
         raise ValueError("n_samples or start_index")

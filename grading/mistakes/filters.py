@@ -5,17 +5,14 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from grading.mistakes import Mistake, Model
+from grading.mistakes import Mistake, Model, valid_points
 
 MAX_LOOPED_POINTS = 20_000  # larger calls are not replayed by the loops below
 MAX_LOOPED_PIXELS = 10_000
 
 
 def _cloud(points):
-    data = np.array(points, dtype=float)
-    if data.ndim != 2 or data.shape[1] < 3 or not np.isfinite(data).all():
-        raise ValueError("not a cloud")
-    return data[:, :3]
+    return valid_points(points, min_columns=3)[:, :3]
 
 
 # -- radius_outlier_removal ----------------------------------------------------------------

@@ -3,16 +3,13 @@
 import numpy as np
 from scipy.spatial import cKDTree
 
-from grading.mistakes import Mistake, Model, same
+from grading.mistakes import Mistake, Model, same, valid_points
 
 MAX_RADIUS_POINTS = 20_000  # radius neighbourhoods are replayed in a loop up to this size
 
 
 def _cloud(points):
-    data = np.array(points, dtype=float)
-    if data.ndim != 2 or data.shape[1] != 3 or not np.isfinite(data).all():
-        raise ValueError("not a cloud")
-    return data
+    return valid_points(points, min_columns=3, max_columns=3)
 
 
 def _unit_sign(vector):

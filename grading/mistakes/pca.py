@@ -3,19 +3,12 @@
 import numpy as np
 from scipy.spatial.distance import cdist
 
-from grading.mistakes import Mistake, Model, Raised, Variants, same
-
-
-def _finite_matrix(points):
-    data = np.array(points, dtype=float)
-    if data.ndim != 2 or data.shape[0] == 0 or not np.isfinite(data).all():
-        raise ValueError("not a valid input")
-    return data
+from grading.mistakes import Mistake, Model, Raised, Variants, same, valid_points
 
 
 def _scatter_eigen(points, correlation=False, ddof=0, centring="columns", guard=True):
     """Eigenpairs of the (mis)normalised covariance, ascending (eigh's order)."""
-    data = _finite_matrix(points)
+    data = valid_points(points, min_rows=1)
     count = data.shape[0]
     offset = {"columns": data.mean(axis=0), "scalar": data.mean(), "none": 0.0}[centring]
     deviations = data - offset
@@ -171,7 +164,7 @@ PCA = Model(
 
 
 def _eig_unsorted(points, correlation):
-    data = _finite_matrix(points)
+    data = valid_points(points, min_rows=1)
     deviations = data - data.mean(axis=0)
     if correlation:
         spread = deviations.std(axis=0)
@@ -209,7 +202,7 @@ def _zero_vectors(pair):
 
 
 def kernel_truth(x, y, kernel="gaussian", beta=1.0, degree=2, l2_laplacian=False, gaussian_square=True, one=1.0):
-    left, right = _finite_matrix(x), _finite_matrix(y)
+    left, right = valid_points(x, min_rows=1), valid_points(y, min_rows=1)
     if left.shape[1] != right.shape[1]:
         raise ValueError("widths differ")
     if kernel == "linear":

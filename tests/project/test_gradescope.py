@@ -27,6 +27,7 @@ from _helpers import load_results, reference_package, reference_source
 
 from grading import EXERCISE_MODULES, GRADED_FUNCTIONS, REPO_ROOT
 from grading.leakcheck import find_leaks
+from grading.plugin import points_per_function
 from grading.sandbox import _make_reachable
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="the dedicated-uid wall needs a root grader")
@@ -75,14 +76,6 @@ def run_autograder(root, namespaces=True, wait=True):
     assert completed.returncode == 0, completed.stdout + completed.stderr
     results = load_results(root / "results" / "results.json")
     return results, completed.stdout
-
-
-def by_function(results):
-    totals = {}
-    for test in results["tests"]:
-        score, maximum = totals.get(test["tags"][0], (0, 0))
-        totals[test["tags"][0]] = (score + test["score"], maximum + test["max_score"])
-    return totals
 
 
 def test_the_archive_has_gradescope_layout_and_no_reference_code(archive, tmp_path):
@@ -144,7 +137,7 @@ def test_a_wrong_module_uploaded_alone_is_graded_without_namespaces(archive, tmp
         + ". Not graded (not exercise modules): `_kernels.py`."
     )
     assert lines[1].startswith("isolated: dedicated uid") and "seccomp" in lines[1]
-    totals = by_function(results)
+    totals = points_per_function(results["tests"])
     assert 0 < totals["pca"][0] < totals["pca"][1]  # the N - 1 covariance loses some of pca's points
     assert totals["kernel_matrix"][0] == totals["kernel_matrix"][1]  # pca.py's other functions are right
     assert totals["fit_plane"][0] == 0
