@@ -3,8 +3,10 @@
 import numpy as np
 
 from pcl_course.validation import as_points, check_choice, check_integer, check_positive, check_rng
-from solutions._kernels import axis_bounds, bucket_fps, hash_groups, hash_table_filter, reservoir_choice, voxel_keys
-from solutions._neighbors import morton_order
+from solutions._fast.bounds import axis_bounds
+from solutions._fast.fps import bucket_fps
+from solutions._fast.order import morton_order
+from solutions._fast.voxel import hash_groups, hash_table_filter, reservoir_choice, voxel_keys
 
 __all__ = ["voxel_grid_downsample", "approximate_voxel_downsample", "farthest_point_sampling", "normal_space_sampling"]
 

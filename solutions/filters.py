@@ -6,7 +6,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_same_shape, check_scalar
-from solutions._neighbors import grid_is_usable, grid_radius_count, kdtree, knn_mean_distance
+from solutions._fast.grid import grid_is_usable, grid_radius_count
+from solutions._fast.knn import kdtree, knn_mean_distance
 
 __all__ = [
     "radius_outlier_removal",

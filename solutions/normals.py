@@ -3,8 +3,8 @@
 import numpy as np
 
 from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_same_shape
-from solutions._kernels import normals_from_neighbourhoods
-from solutions._neighbors import kdtree, knn_normals
+from solutions._fast.eig3 import normals_from_neighbourhoods
+from solutions._fast.knn import kdtree, knn_normals
 
 __all__ = ["fit_plane", "estimate_normals"]
 

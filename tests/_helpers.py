@@ -55,7 +55,16 @@ def reference_source(module):
     return (REPO_ROOT / "solutions" / f"{module}.py").read_text().replace("from solutions.", "from pcl_course.")
 
 
-REFERENCE_KERNELS = ("_kernels", "_neighbors")  # the references' private modules
+# The references' private modules: the compiled kernels, as paths under solutions/ without ".py".
+REFERENCE_KERNELS = tuple(sorted(f"_fast/{path.stem}" for path in (REPO_ROOT / "solutions" / "_fast").glob("*.py")))
+
+
+def write_reference_modules(package, modules):
+    """Write the reference modules ``modules`` (and the kernels they import) into the student package ``package``."""
+    for module in (*modules, *REFERENCE_KERNELS):
+        path = package / f"{module}.py"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(reference_source(module))
 
 
 def reference_package(target):
@@ -65,8 +74,7 @@ def reference_package(target):
     from grading import EXERCISE_MODULES
 
     shutil.copytree(REPO_ROOT / "pcl_course", target, ignore=shutil.ignore_patterns("__pycache__"))
-    for module in (*EXERCISE_MODULES, *REFERENCE_KERNELS):
-        (target / f"{module}.py").write_text(reference_source(module))
+    write_reference_modules(target, EXERCISE_MODULES)
     return target
 
 

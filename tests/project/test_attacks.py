@@ -18,7 +18,7 @@ import threading
 import time
 
 import pytest
-from _helpers import load_results, run_batch, run_grader
+from _helpers import load_results, run_batch, run_grader, write_reference_modules
 
 from grading import REPO_ROOT
 from grading.sandbox import _make_reachable, isolation
@@ -336,8 +336,7 @@ def test_an_input_modified_in_place_fails_as_it_does_locally(tmp_path):
     wrong = "\n".join(line for line in mutant.read_text().splitlines() if not line.startswith("from solutions."))
     reference = (REPO_ROOT / "solutions" / "pca.py").read_text().replace("from solutions.", "from pcl_course.")
     clone = make_submission(tmp_path / "clone", {"pca.py": reference + "\n\n" + wrong + "\n"})
-    shutil.copy(REPO_ROOT / "solutions" / "_kernels.py", clone / "pcl_course" / "_kernels.py")
-    shutil.copy(REPO_ROOT / "solutions" / "_neighbors.py", clone / "pcl_course" / "_neighbors.py")
+    write_reference_modules(clone / "pcl_course", ())
     official, _ = grade(clone, tmp_path, "-k", "test_pca_")
     status = {t["name"]: t["status"] for t in local["tests"]}
     assert status["test_pca_does_not_modify_its_input"] == "failed"

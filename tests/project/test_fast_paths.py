@@ -17,8 +17,10 @@ import pytest
 from scipy.spatial import cKDTree
 
 from solutions import downsampling, filters, normals, pca
-from solutions._kernels import hash_groups, smallest_eigenpair
-from solutions._neighbors import grid_is_usable, grid_radius_count, leaf_knn
+from solutions._fast.eig3 import smallest_eigenpair
+from solutions._fast.grid import grid_is_usable, grid_radius_count
+from solutions._fast.knn import leaf_knn
+from solutions._fast.voxel import hash_groups
 
 
 def _clouds():

@@ -127,14 +127,14 @@ def test_a_wrong_module_uploaded_alone_is_graded_without_namespaces(archive, tmp
     )
     assert wrong != reference_source("pca")
     (root / "submission" / "pca.py").write_text(wrong)
-    (root / "submission" / "_kernels.py").write_text(reference_source("_kernels"))
+    (root / "submission" / "helpers.py").write_text("SCALE = 1.0\n")
     (root / "submission" / "notes.txt").write_text("my notes")
     results, _ = run_autograder(root, namespaces=False)
     lines = results["output"].splitlines()
     assert lines[0] == (
         "Graded from the uploaded files: `pca.py`. Missing (graded as the course's stub, 0 points): "
         + ", ".join(f"`{m}.py`" for m in EXERCISE_MODULES if m != "pca")
-        + ". Not graded (not exercise modules): `_kernels.py`."
+        + ". Not graded (not exercise modules): `helpers.py`."
     )
     assert lines[1].startswith("isolated: dedicated uid") and "seccomp" in lines[1]
     totals = points_per_function(results["tests"])

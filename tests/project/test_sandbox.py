@@ -8,7 +8,7 @@ import textwrap
 
 import numpy as np
 import pytest
-from _helpers import reference_source, run_grader
+from _helpers import reference_source, run_grader, write_reference_modules
 
 from grading import REPO_ROOT
 from grading.errors import SandboxError
@@ -200,8 +200,7 @@ def test_the_reference_and_the_tests_are_not_readable(worker):
 def make_clone(tmp_path, replace=None):
     clone = tmp_path / "clone"
     shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
-    for module in ("pca", "normals", "metrics", "_kernels", "_neighbors"):
-        (clone / "pcl_course" / f"{module}.py").write_text(reference_source(module))
+    write_reference_modules(clone / "pcl_course", ("pca", "normals", "metrics"))
     for name, text in (replace or {}).items():
         (clone / name).parent.mkdir(parents=True, exist_ok=True)
         (clone / name).write_text(text)
