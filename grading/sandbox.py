@@ -289,8 +289,39 @@ def _environment(home):
     }
 
 
+def _tasks_of_user(uid):
+    """How many processes and threads the real user ``uid`` has now (what ``RLIMIT_NPROC`` counts)."""
+    count = 0
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            if os.stat(entry.path).st_uid == uid:
+                count += len(os.listdir(f"{entry.path}/task"))
+        except OSError:  # gone since the scan
+            continue
+    return count
+
+
+def _process_limit(uid):
+    """``RLIMIT_NPROC`` for a worker: :data:`config.PROCESS_LIMIT` more tasks than its user has now.
+
+    A dedicated uid has none, so its limit is ``PROCESS_LIMIT``. A grader that
+    is not root shares its own uid with its other workers, its test runner
+    and the rest of the user's session: a fixed limit would let one
+    submission's fork bomb stop a neighbour's worker from starting, or
+    refuse a busy session its first worker at all.
+    """
+    if uid is not None or not sys.platform.startswith("linux"):
+        return config.PROCESS_LIMIT
+    limit = _tasks_of_user(os.getuid()) + config.PROCESS_LIMIT
+    _, hard = resource.getrlimit(resource.RLIMIT_NPROC)
+    return limit if hard == resource.RLIM_INFINITY else min(limit, hard)
+
+
 def _preexec(uid):
     """Run in the worker's process before exec: its own session, limits, the sandbox uid."""
+    process_limit = _process_limit(uid) if uid is not None or os.geteuid() != 0 else None
 
     def apply():
         os.setsid()  # its own process group: killed as a whole, forks included
@@ -310,8 +341,8 @@ def _preexec(uid):
             os.setgroups([])
             os.setgid(uid)
             os.setuid(uid)
-        if uid is not None or os.geteuid() != 0:
-            resource.setrlimit(resource.RLIMIT_NPROC, (config.PROCESS_LIMIT, config.PROCESS_LIMIT))
+        if process_limit is not None:
+            resource.setrlimit(resource.RLIMIT_NPROC, (process_limit, process_limit))
 
     return apply
 

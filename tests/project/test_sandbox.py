@@ -3,6 +3,7 @@ its own calls, never the grader's process, and sees neither the reference
 nor the tests."""
 
 import os
+import resource
 import shutil
 import textwrap
 
@@ -341,3 +342,16 @@ def test_the_level_is_named_in_the_results_and_can_be_required(tmp_path):
     assert refused.returncode == 1
     assert refused.stderr.startswith("error: refusing to grade: the submission could not be isolated")
     assert len(refused.stderr.strip().splitlines()) == 1 and "Traceback" not in refused.stderr
+
+
+def test_a_grader_without_a_dedicated_uid_leaves_room_for_its_own_processes():
+    """Without root, every worker shares the grader's uid: its process limit counts what runs already."""
+    from grading import config
+    from grading.sandbox import _process_limit, _tasks_of_user
+
+    assert _process_limit(60_500) == config.PROCESS_LIMIT  # a dedicated uid starts with nothing
+    running = _tasks_of_user(os.getuid())
+    assert running >= 1  # this test's own process, at least
+    _, hard = resource.getrlimit(resource.RLIMIT_NPROC)
+    expected = running + config.PROCESS_LIMIT
+    assert _process_limit(None) >= (expected if hard == resource.RLIM_INFINITY else min(expected, hard))
