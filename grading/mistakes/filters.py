@@ -5,7 +5,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from grading.mistakes import Mistake, Model, valid_points
+from grading.mistakes import Mistake, Model, Raised, valid_points
 
 MAX_LOOPED_POINTS = 20_000  # larger calls are not replayed by the loops below
 MAX_LOOPED_PIXELS = 10_000
@@ -69,6 +69,11 @@ def _statistical(**changes):
     return lambda points, k, std_ratio: statistical_keep(points, k, std_ratio, **changes)
 
 
+def _rejects_the_largest_k(points, k, std_ratio):
+    """A range check one short: ``k = N - 1`` (every other point) refused."""
+    return Raised("ValueError") if int(k) == len(_cloud(points)) - 1 else None
+
+
 STATISTICAL_OUTLIER_REMOVAL = Model(
     truth=statistical_keep,
     output_dtypes=("bool",),
@@ -98,6 +103,11 @@ STATISTICAL_OUTLIER_REMOVAL = Model(
             "strict_threshold",
             "keep where d_i <= mu + std_ratio * sigma (<=, not <): with sigma = 0 a strict test removes every point",
             _statistical(strict=True),
+        ),
+        Mistake(
+            "rejects_the_largest_k",
+            "k = N - 1 is allowed (every other point is a neighbour): reject only k < 1 and k > N - 1",
+            _rejects_the_largest_k,
         ),
     ),
 )

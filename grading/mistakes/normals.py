@@ -100,6 +100,17 @@ def _neighbourhoods(xyz, k, radius, itself=True, strict=False, ignore_k=False):
     return found
 
 
+class _Normals(tuple):
+    """``(normals, curvature)`` as the model computes them, knowing where the normal is not unique.
+
+    ``ambiguous`` marks the points whose smallest eigenvalue is not simple
+    (coincident points, a line): every unit vector of a whole plane or space
+    is a right normal there, so normals are not compared at those points.
+    """
+
+    ambiguous = None
+
+
 def normals(points, k=30, radius=None, viewpoint=None, **changes):
     xyz = _cloud(points)
     if radius is None and k is None:
@@ -112,9 +123,11 @@ def normals(points, k=30, radius=None, viewpoint=None, **changes):
     rows = changes.pop("rows", False)
     largest_curvature = changes.pop("largest_curvature", False)
     centred = changes.pop("centred", True)
+    zero_trace_nan = changes.pop("zero_trace_nan", False)
     orient = changes.pop("orient", True)
     result_normals = np.full(xyz.shape, np.nan)
     curvature = np.full(len(xyz), np.nan)
+    ambiguous = np.zeros(len(xyz), dtype=bool)
     members = _neighbourhoods(xyz, k, radius, **changes)
     sizes = np.array([len(m) for m in members], dtype=np.int64)
     for size in np.unique(sizes[sizes >= 3]):  # equal sizes: one batched eigendecomposition
@@ -124,13 +137,16 @@ def normals(points, k=30, radius=None, viewpoint=None, **changes):
         values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", spread, spread) / size)
         result_normals[which] = vectors[:, pick, :] if rows else vectors[:, :, pick]
         trace = values.sum(axis=1)
+        ambiguous[which] = values[:, 1] - values[:, 0] <= 1e-9 * np.maximum(np.abs(values[:, 2]), 1e-300)
         top = values[:, -1] if largest_curvature else np.maximum(values[:, 0], 0.0)
         with np.errstate(invalid="ignore", divide="ignore"):
-            curvature[which] = np.where(trace > 0, top / trace, 0.0)
+            curvature[which] = top / trace if zero_trace_nan else np.where(trace > 0, top / trace, 0.0)
     if viewpoint is not None and orient:
         facing = np.sum(result_normals * (np.asarray(viewpoint, dtype=float) - xyz), axis=1)
         result_normals[facing < 0] *= -1
-    return result_normals, curvature
+    answer = _Normals((result_normals, curvature))
+    answer.ambiguous = ambiguous
+    return answer
 
 
 def _tie_free(arguments):
@@ -163,6 +179,10 @@ def _agreement(a, b, arguments, oriented):
     cosine = cosine if oriented else np.abs(cosine)
     nan_a, nan_b = np.isnan(normals_a).any(axis=1), np.isnan(normals_b).any(axis=1)
     agree_normal = np.where(nan_a | nan_b, nan_a == nan_b, cosine >= 1 - 1e-6)
+    for answer in (a, b):  # where the model knows the normal is not unique, any unit normal agrees
+        ambiguous = getattr(answer, "ambiguous", None)
+        if ambiguous is not None and ambiguous.shape == agree_normal.shape:
+            agree_normal |= ambiguous & ~nan_a & ~nan_b
     agree_curvature = np.isclose(curvature_a, curvature_b, rtol=1e-5, atol=1e-8, equal_nan=True)
     free = _tie_free(arguments) if "points" in arguments else np.ones(len(normals_b), bool)
     if free.shape != agree_normal.shape or not free.any():
@@ -175,10 +195,11 @@ def _normals_same(a, b, arguments):
 
 
 class _Wrong:
-    """A prediction known only by how it differs from the truth."""
+    """A prediction known only by how it differs from the truth (at the points ``where``, if known)."""
 
-    def __init__(self, truth):
+    def __init__(self, truth, where=None):
         self.truth = truth
+        self.where = where
 
 
 def _far_wrong_same(a, b, arguments):
@@ -233,6 +254,33 @@ def _small_neighbourhoods_same(a, b, arguments):
 def _with_small_neighbourhoods(points, k=30, radius=None, viewpoint=None):
     truth = normals(points, k, radius, viewpoint)
     return _Wrong(truth) if np.isnan(truth[0]).any() else None
+
+
+def _with_zero_traces(points, k=30, radius=None, viewpoint=None):
+    truth = normals(points, k, radius, viewpoint)
+    nan_curvature = np.isnan(normals(points, k, radius, viewpoint, zero_trace_nan=True)[1])
+    where = nan_curvature & ~np.isnan(truth[1])  # every neighbour at the same spot: l = 0 and trace = 0
+    return _Wrong(truth, where) if where.any() else None
+
+
+def _zero_traces_same(a, b, arguments):
+    """A NaN curvature where the trace is 0, right elsewhere (any unit normal is right at such points)."""
+    if isinstance(b, _Wrong):
+        try:
+            normals_a, curvature_a = (np.asarray(x, dtype=float) for x in a)
+        except Exception:
+            return False
+        if curvature_a.shape != b.truth[1].shape or normals_a.shape != b.truth[0].shape:
+            return False
+        rest = ~b.where
+        agreement = _agreement(
+            (normals_a[rest], curvature_a[rest]),
+            (b.truth[0][rest], b.truth[1][rest]),
+            {key: value for key, value in arguments.items() if key != "points"},
+            oriented=arguments.get("viewpoint") is not None,
+        )
+        return bool(np.isnan(curvature_a[b.where]).all()) and agreement >= 0.98
+    return not isinstance(a, _Wrong) and _normals_same(a, b, arguments)
 
 
 def _changed(**changes):
@@ -310,6 +358,14 @@ ESTIMATE_NORMALS = Model(
             "a neighbourhood of fewer than 3 points defines no plane: its normal and curvature must be NaN",
             _with_small_neighbourhoods,
             same=_small_neighbourhoods_same,
+            exclusive=True,
+        ),
+        Mistake(
+            "zero_trace_curvature",
+            "where every neighbour is at the same spot, l_1 + l_2 + l_3 = 0: the curvature is defined as 0 there, "
+            "not 0 / 0 = NaN",
+            _with_zero_traces,
+            same=_zero_traces_same,
             exclusive=True,
         ),
     ),

@@ -100,6 +100,22 @@ def test_statistical_outlier_removal_matches_its_definition(impl):
 
 
 @pytest.mark.grades("statistical_outlier_removal")
+@pytest.mark.points(1)
+def test_statistical_outlier_removal_with_every_other_point_as_a_neighbour(impl):
+    # k = N - 1, the largest k the contract allows: d_i is the mean distance to ALL other points.
+    x = np.array([0.0, 1.0, 2.0, 3.0, 4.0, 12.0])
+    points = np.column_stack([x, np.zeros(6), np.zeros(6)])
+    mean_d = np.abs(x[:, None] - x[None, :]).sum(axis=1) / 5  # 4.4, 3.6, 3.2, 3.2, 3.6, 10.0
+    expected = mean_d <= mean_d.mean() + 1.0 * mean_d.std(ddof=1)
+    keep = impl.statistical_outlier_removal(points, 5, 1.0)
+    check_array(keep, "keep", shape=(6,), dtype="bool")
+    assert keep.tolist() == expected.tolist() == [True] * 5 + [False], (
+        f"with k = N - 1 = 5 (allowed: every other point is a neighbour) expected {expected.tolist()}, "
+        f"got {keep.tolist()}"
+    )
+
+
+@pytest.mark.grades("statistical_outlier_removal")
 @pytest.mark.points(2)
 def test_statistical_outlier_removal_hand_built(impl):
     # Six points on a line, k = 1: nearest-other distances 1, 1, 1, 1, 1, 4.

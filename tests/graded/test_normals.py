@@ -264,6 +264,27 @@ def test_estimate_normals_fewer_than_three_neighbours_give_nan(impl):
 
 
 @pytest.mark.grades("estimate_normals")
+@pytest.mark.points(1)
+def test_estimate_normals_curvature_is_zero_where_the_points_coincide(impl):
+    # Three spots of four duplicates each (a scanner returns the same point several times): with k = 3,
+    # every neighbourhood is one spot, whose covariance is 0.
+    points = np.repeat([[0.0, 0.0, 0.0], [5.0, 1.0, 2.0], [1.0, 7.0, 3.0]], 4, axis=0)
+    normals, curvature = impl.estimate_normals(points, k=3)
+    check_close(
+        curvature,
+        np.zeros(12),
+        "curvature",
+        hint="where the trace l_1 + l_2 + l_3 is 0 the curvature is defined as 0, not 0 / 0 = NaN",
+    )
+    check_close(
+        np.linalg.norm(normals, axis=1),
+        np.ones(12),
+        "norm of each normal",
+        hint="3 neighbours define a normal, here any unit vector: it must not be NaN",
+    )
+
+
+@pytest.mark.grades("estimate_normals")
 @pytest.mark.points(2)
 def test_estimate_normals_orients_towards_the_viewpoint(impl):
     rng = np.random.default_rng(12)

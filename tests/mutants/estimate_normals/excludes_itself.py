@@ -21,7 +21,7 @@ def estimate_normals(points, k=30, radius=None, viewpoint=None):
             continue
         d = nb - nb.mean(axis=0)
         values, vectors = np.linalg.eigh(d.T @ d)
-        normals[i], curvature[i] = vectors[:, 0], values[0] / values.sum()
+        normals[i], curvature[i] = vectors[:, 0], (values[0] / values.sum() if values.sum() > 0 else 0.0)
     if viewpoint is not None:
         flip = np.sum(normals * (np.asarray(viewpoint) - points), axis=1) < 0
         normals[flip] *= -1

@@ -23,7 +23,7 @@ def estimate_normals(points, k=30, radius=None, viewpoint=None):
         nb = points[row]
         d = nb - nb.mean(axis=0)
         values, vectors = np.linalg.eigh(d.T @ d / len(nb))
-        normals[i], curvature[i] = vectors[:, -1], values[0] / values.sum()
+        normals[i], curvature[i] = vectors[:, -1], (values[0] / values.sum() if values.sum() > 0 else 0.0)
     if viewpoint is not None:
         flip = np.sum(normals * (np.asarray(viewpoint) - points), axis=1) < 0
         normals[flip] *= -1
