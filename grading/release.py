@@ -54,10 +54,24 @@ def _substitute(text, old, new, where, regex=False):
     return text
 
 
+INSTRUCTOR_ONLY = "instructor-only"  # the class that keeps a {solution} out of the student release
+
+
 def _strip_solutions(markdown):
-    """Remove ``{solution}`` directives (colon or backtick fences)."""
-    markdown = re.sub(r"^(:{3,})\{solution\}.*?^\1[ \t]*$\n?", "", markdown, flags=re.S | re.M)
-    return re.sub(r"^(`{3,})\{solution\}.*?^\1[ \t]*$\n?", "", markdown, flags=re.S | re.M)
+    """Remove the ``{solution}`` directives of class ``instructor-only`` (colon or backtick fences).
+
+    The other solutions are the answers of the book's self-checks, hidden
+    behind a dropdown: students keep them.
+    """
+    for fence in (":", "`"):
+        # The fence, the directive, its option lines up to a :class: naming INSTRUCTOR_ONLY,
+        # then anything up to the same closing fence.
+        pattern = (
+            rf"^({re.escape(fence)}{{3,}})\{{solution\}}[^\n]*\n(?:(?!\1[ \t]*$)[^\n]*\n)*?"
+            rf":class:[^\n]*\b{INSTRUCTOR_ONLY}\b[\s\S]*?^\1[ \t]*$\n?"
+        )
+        markdown = re.sub(pattern, "", markdown, flags=re.M)
+    return markdown
 
 
 def _student_config(text):

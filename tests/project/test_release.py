@@ -62,11 +62,22 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
     assert "REFERENCE_PACKAGE = None" in (release_dir / "pcl_course" / "book.py").read_text()
 
 
-def test_solution_blocks_are_removed_from_the_book(release_dir):
-    assert "{solution}" in (REPO_ROOT / "book" / "kernel_pca.md").read_text()  # there is one to remove
+def test_instructor_solutions_are_removed_and_self_check_answers_kept(release_dir):
+    from grading.release import _strip_solutions
+
+    page = (
+        "Intro.\n\n:::{exercise}\n:label: a\nQuestion A.\n:::\n\n"
+        ":::{solution} a\n:class: dropdown\nAnswer A.\n:::\n\n"
+        ":::{solution} b\n:class: dropdown instructor-only\nAnswer B.\n:::\n\n"
+        "````{solution} c\n:class: instructor-only\nAnswer C.\n````\nOutro.\n"
+    )
+    stripped = _strip_solutions(page)
+    assert "Answer A." in stripped and "Question A." in stripped and "Outro." in stripped
+    assert "Answer B." not in stripped and "Answer C." not in stripped
     for page in (release_dir / "book").glob("*.md"):
-        assert "{solution}" not in page.read_text(), page.name
-    assert "{exercise}" in (release_dir / "book" / "kernel_pca.md").read_text()
+        assert "instructor-only" not in page.read_text(), page.name
+    released = (release_dir / "book" / "downsampling.md").read_text()
+    assert "{solution} cyu-voxel-indices" in released  # the self-checks keep their answers
 
 
 def test_the_release_contains_no_reference_code(release_dir):
@@ -150,7 +161,7 @@ def test_the_release_book_builds_with_the_stubs(release_dir):
     assert completed.returncode == 0, completed.stdout[-3000:] + completed.stderr[-3000:]
     page = (release_dir / "_build" / "html" / "book" / "pca.html").read_text()
     assert "Not implemented yet: pca" in page
-    assert "lambda_k = sigma_k^2 / N: True" not in page  # no reference results
+    assert "lambda_k = s_k^2 / N: True" not in page  # no reference results
     assert find_leaks(release_dir / "_build" / "html") == []
 
 
