@@ -37,6 +37,10 @@ __all__ = [
     "LIDAR_CLASSES",
     "make_street_scene",
     "simulate_lidar_scan",
+    "published_table",
+    "CameraView",
+    "KITTI_CAMERA",
+    "render_street_view",
 ]
 
 SHAPE_NAMES = (
@@ -646,3 +650,130 @@ def simulate_lidar_scan(
         ring=np.concatenate([ring, ring[source]]),
         is_outlier=np.concatenate([np.zeros(n, dtype=bool), np.ones(n_out, dtype=bool)]),
     )
+
+
+# --- a camera view of the street (depth completion) ---------------------------------
+
+
+# KITTI's camera 2, approximately: image size (pixels), focal length and principal point (pixels).
+KITTI_CAMERA = {"width": 1242, "height": 375, "focal": 721.5, "cx": 609.6, "cy": 172.9}
+
+_ALBEDO = {
+    "ground": (0.35, 0.35, 0.38),
+    "building": (0.75, 0.6, 0.45),
+    "car": (0.7, 0.1, 0.1),
+    "pole": (0.3, 0.3, 0.3),
+    "vegetation": (0.2, 0.55, 0.2),
+    "pedestrian": (0.2, 0.3, 0.8),
+}
+
+
+@dataclass(frozen=True)
+class CameraView:
+    """What a pinhole camera at the lidar sees of the street.
+
+    Attributes
+    ----------
+    rgb : ndarray of float64, shape (height, width, 3)
+        A shaded colour image in [0, 1], with darker windows on the facades and a little noise.
+    depth : ndarray of float64, shape (height, width)
+        Ground-truth z-depth in metres (along the optical axis, as KITTI's), 0 where there is no
+        surface within ``max_depth``.
+    camera : dict
+        ``width``, ``height``, ``focal``, ``cx``, ``cy`` (pixels).
+    """
+
+    rgb: np.ndarray
+    depth: np.ndarray
+    camera: dict
+
+
+def render_street_view(seed=0, max_depth=80.0, camera=None):
+    """Render :func:`make_street_scene` from the lidar's position, looking down the street (+x).
+
+    Open3D's ray casting gives every pixel the distance to the first surface,
+    its normal and its object; the depth map and a Lambert-shaded colour
+    image follow from those.
+
+    Parameters
+    ----------
+    seed : int, default 0
+        The street (:func:`make_street_scene`) and the image noise.
+    max_depth : float, default 80.0
+        Metres; farther surfaces get depth 0, as in KITTI's ground truth.
+    camera : dict, optional
+        ``width``, ``height``, ``focal``, ``cx``, ``cy``; :data:`KITTI_CAMERA` by default.
+
+    Returns
+    -------
+    CameraView
+    """
+    import open3d as o3d
+
+    camera = dict(KITTI_CAMERA if camera is None else camera)
+    width, height, focal, cx, cy = (camera[key] for key in ("width", "height", "focal", "cx", "cy"))
+    scene = o3d.t.geometry.RaycastingScene()
+    label_of = {}
+    for mesh, label in make_street_scene(seed=seed):
+        label_of[scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))] = label
+
+    u, v = np.meshgrid(np.arange(width), np.arange(height))
+    # Camera axes: x right, y down, z forward; the lidar frame has x forward, y left, z up.
+    world = np.stack([np.ones(u.shape), -(u - cx) / focal, -(v - cy) / focal], axis=-1)
+    directions = world / np.linalg.norm(world, axis=-1, keepdims=True)
+    rays = np.concatenate([np.zeros_like(directions), directions], axis=-1).reshape(-1, 6).astype(np.float32)
+    hits = scene.cast_rays(o3d.core.Tensor(rays))
+    distance = hits["t_hit"].numpy().reshape(height, width).astype(float)
+    depth = distance * directions[..., 0]
+    depth[~np.isfinite(depth) | (depth > max_depth)] = 0.0
+
+    geometry = hits["geometry_ids"].numpy().reshape(height, width)
+    normals = hits["primitive_normals"].numpy().reshape(height, width, 3)
+    points = directions * np.where(np.isfinite(distance), distance, 0.0)[..., None]
+    light = np.array([0.3, 0.5, 0.8]) / np.linalg.norm([0.3, 0.5, 0.8])
+    rgb = np.empty((height, width, 3))
+    rgb[:] = (0.6, 0.75, 0.95)  # sky
+    for geometry_id, label in label_of.items():
+        where = geometry == geometry_id
+        colour = np.array(_ALBEDO[label]) * (0.35 + 0.65 * np.abs(normals[where] @ light))[:, None]
+        if label == "building":  # a grid of darker windows
+            p = points[where]
+            colour[(np.mod(p[:, 0] + p[:, 1], 3.0) < 1.2) & (np.mod(p[:, 2], 3.0) > 1.2)] *= 0.45
+        rgb[where] = colour
+    rgb = np.clip(rgb + np.random.default_rng(seed).normal(scale=0.02, size=rgb.shape), 0.0, 1.0)
+    return CameraView(rgb=rgb, depth=depth, camera=camera)
+
+
+# --- published results the book cites ---------------------------------------------
+
+
+_PUBLISHED = Path(__file__).parent / "data"
+
+
+def published_table(name):
+    """A table of published results shipped with the course, as columns.
+
+    Parameters
+    ----------
+    name : str
+        The file's name without ``.csv`` in ``pcl_course/data/``, e.g.
+        ``"snet_modelnet40_classification"`` (Dovrat et al., "Learning to
+        Sample", CVPR 2019: PointNet's accuracy on ModelNet40 when each test
+        cloud is reduced by random sampling, FPS or S-NET).
+
+    Returns
+    -------
+    columns : dict of str to ndarray of float64
+        One array per column, in the file's order.
+    source : str
+        The file's leading ``#`` comment lines: what the numbers are, and where they were published.
+    """
+    path = _PUBLISHED / f"{name}.csv"
+    if not path.is_file():
+        known = sorted(p.stem for p in _PUBLISHED.glob("*.csv"))
+        raise ValueError(f"name must be one of {known}, got {name!r}")
+    lines = path.read_text().splitlines()
+    source = " ".join(line.lstrip("# ").strip() for line in lines if line.startswith("#"))
+    rows = [line.split(",") for line in lines if line and not line.startswith("#")]
+    header, values = rows[0], np.array(rows[1:], dtype=float)
+    return {column: values[:, j] for j, column in enumerate(header)}, source

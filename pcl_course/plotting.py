@@ -6,7 +6,7 @@ that a sphere looks like a sphere.
 
 import numpy as np
 
-__all__ = ["new_3d_axes", "set_axes_equal", "plot_cloud", "plot_vectors"]
+__all__ = ["new_3d_axes", "set_axes_equal", "plot_cloud", "plot_vectors", "depth_panels", "worst_difference_window"]
 
 
 def new_3d_axes(fig, *position, title=None, elev=25, azim=-60):
@@ -128,9 +128,10 @@ def interactive_figure(traces, title=None, height=520, camera_eye=(1.4, -1.4, 0.
     figure.update_layout(
         title=title,
         height=height,
-        margin=dict(l=0, r=0, t=40 if title else 10, b=0),
+        margin=dict(l=0, r=0, t=40 if title else 10, b=30),
         scene=dict(aspectmode="data", camera=dict(eye=dict(zip("xyz", camera_eye)))),
-        legend=dict(itemsizing="constant"),
+        # Below the scene, left: the mode bar takes the top right corner.
+        legend=dict(itemsizing="constant", orientation="h", x=0.0, xanchor="left", y=0.0, yanchor="top"),
     )
     return figure
 
@@ -142,3 +143,67 @@ def show_interactive(figure):
     return HTML(
         figure.to_html(full_html=False, include_plotlyjs=False, config={"displaylogo": False, "responsive": True})
     )
+
+
+def depth_panels(panels, vmax, label, cmap="turbo_r", columns=1, box=None, zero_is_missing=True):
+    """Images and depth maps in a grid, with one colour bar for the maps.
+
+    Parameters
+    ----------
+    panels : list of (str, ndarray)
+        Titles and images: ``(H, W, 3)`` colour images are shown as they are,
+        ``(H, W)`` maps with ``cmap`` from 0 to ``vmax``.
+    vmax : float
+        Top of the colour scale (the maps' unit, e.g. metres).
+    label : str
+        The colour bar's label.
+    columns : int, default 1
+    box : (slice, slice), optional
+        Rows and columns of a rectangle to outline in white on every panel.
+    zero_is_missing : bool, default True
+        Show 0 as blank (no measurement), as for depth maps.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    rows = -(-len(panels) // columns)
+    height, width = panels[0][1].shape[:2]
+    fig, axes = plt.subplots(
+        rows, columns, figsize=(12, rows * 12 / columns * height / width + 0.6), layout="constrained", squeeze=False
+    )
+    mapped = None
+    for ax, (title, image) in zip(axes.flat, panels):
+        if image.ndim == 3:
+            ax.imshow(image)
+        else:
+            shown = np.where(image > 0, image, np.nan) if zero_is_missing else image
+            mapped = ax.imshow(shown, cmap=cmap, vmin=0.0, vmax=vmax)
+        if box is not None:
+            ys, xs = box
+            ax.add_patch(Rectangle((xs.start, ys.start), xs.stop - xs.start, ys.stop - ys.start, fill=False,
+                                   edgecolor="white", lw=1.5))  # fmt: skip
+        ax.set_title(title)
+        ax.set_axis_off()
+    for ax in list(axes.flat)[len(panels) :]:
+        ax.set_axis_off()
+    if mapped is not None:
+        fig.colorbar(mapped, ax=axes, label=label, shrink=0.8)
+    plt.show()
+
+
+def worst_difference_window(error_a, error_b, valid, size):
+    """The window of ``size`` (rows, columns) where ``error_a - error_b`` sums highest over ``valid`` pixels.
+
+    Returns
+    -------
+    rows, columns : slice
+    """
+    from scipy.ndimage import uniform_filter
+
+    gain = np.where(valid, error_a - error_b, 0.0)
+    height, width = size
+    mean = uniform_filter(gain, size=(height, width), mode="constant")
+    row, column = np.unravel_index(np.argmax(mean), mean.shape)
+    top = int(np.clip(row - height // 2, 0, gain.shape[0] - height))
+    left = int(np.clip(column - width // 2, 0, gain.shape[1] - width))
+    return slice(top, top + height), slice(left, left + width)

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from grading import REPO_ROOT
 from pcl_course import datasets
 from pcl_course.io import (
     read_kitti_bin,
@@ -199,3 +200,25 @@ def test_kitti_depth_png_round_trip(tmp_path):
     back = read_kitti_depth_png(tmp_path / "0000000005.png")
     assert back.shape == depth.shape and np.all((back > 0) == (depth > 0))
     assert np.abs(back - depth).max() <= 0.5 / 256 + 1e-12
+
+
+SHARED_DATA = REPO_ROOT.parent / "shared" / "data"
+
+
+def test_published_table_reads_the_lecture_table_with_its_source():
+    table, source = datasets.published_table("snet_modelnet40_classification")
+    assert list(table) == ["sampled_points", "random", "fps", "s_net"]
+    assert table["sampled_points"].tolist() == [1024, 512, 256, 128, 64, 32, 16, 8, 4, 2]
+    assert all(np.all((column > 0) & (column <= 100)) for name, column in table.items() if name != "sampled_points")
+    assert "Dovrat" in source and "Learning to Sample" in source
+
+
+@pytest.mark.skipif(not SHARED_DATA.is_dir(), reason="../shared/data is not beside this clone")
+def test_published_tables_are_the_shared_files_unchanged():
+    for path in (REPO_ROOT / "pcl_course" / "data").glob("*.csv"):
+        assert path.read_bytes() == (SHARED_DATA / path.name).read_bytes(), f"{path.name} differs from ../shared/data"
+
+
+def test_published_table_rejects_an_unknown_name():
+    with pytest.raises(ValueError, match="name must be one of"):
+        datasets.published_table("no_such_table")
