@@ -64,7 +64,7 @@ def test_chapters_are_executed_without_errors_or_warnings(name):
 def test_pca_chapter_shows_its_numerical_checks():
     html = page("book/pca")
     for line in (
-        "lambda_k = sigma_k^2 / N: True",
+        "lambda_k = s_k^2 / N: True",
         "first PC of deflated = u_2: True",
         "ours x N/(N-1) == sklearn: True",
         "same canonical coordinates: True",

@@ -1,0 +1,88 @@
+"""Every measured number the book states comes from an executed cell.
+
+A sentence or a figure caption that states a decimal number or a
+percentage must either take it from a cell with ``{glue:text}`` (so the
+build fails if the cell no longer produces it), or repeat a literal that one
+of the page's code cells sets (a parameter such as ``sigma_r = 0.15``: then
+the text and the code change together, or this test fails). A number typed
+by hand from an output, such as a measured error, is neither, and fails.
+
+Mathematics (``$...$``, display blocks) is not checked: it holds derivations
+and worked examples by hand, whose code checks follow them. Integers are not
+checked (counts, years, sizes and powers of two are mostly definitions);
+version numbers of pinned packages and of Python are allowed, and so is a
+sentence that cites its source with ``{cite}``.
+"""
+
+import re
+import sys
+
+import pytest
+
+from grading import REPO_ROOT
+
+# A decimal number or a percentage, not part of a word, an exponent or a longer number.
+NUMBER = re.compile(r"(?<![\w.^{\\])(\d+\.\d+(?:\s?%)?|\d+\s?%)(?![\w.]\d)")
+CODE_CELL = re.compile(r"^```\{code-cell\}[^\n]*\n(.*?)^```", re.S | re.M)
+CAPTION = re.compile(r"caption: \|\n(.*?)\n\s+name:", re.S)
+FRONT_MATTER = re.compile(r"\A---\n.*?\n---\n", re.S)
+
+
+def book_pages():
+    return sorted((REPO_ROOT / "book").glob("*.md"))
+
+
+def allowed_versions():
+    versions = {f"{sys.version_info.major}.{sys.version_info.minor}"}
+    for line in (REPO_ROOT / "requirements.txt").read_text().splitlines():
+        match = re.match(r"[\w.-]+==(\d+)\.(\d+)", line)
+        if match:
+            versions.add(f"{match[1]}.{match[2]}")
+    return versions
+
+
+def stated_numbers(text):
+    """``(where, number)`` for every number stated in the prose and the captions of a MyST page."""
+    text = FRONT_MATTER.sub("", text)
+    found = [("caption", n) for cell in CODE_CELL.findall(text) for caption in CAPTION.findall(cell)
+             for n in NUMBER.findall(caption)]  # fmt: skip
+    prose = CODE_CELL.sub("", text)
+    prose = re.sub(r"\$\$.*?\$\$", "", prose, flags=re.S)  # derivations and worked examples, not results
+    prose = re.sub(r"\$[^$\n]+\$", "", prose)
+    prose = re.sub(r"^```.*?^```", "", prose, flags=re.S | re.M)  # other fenced blocks
+    prose = re.sub(r"\{glue:[a-z]*\}`[^`]*`", "", prose)
+    prose = re.sub(r"`[^`]*`", "", prose)  # inline code
+    prose = re.sub(r"\]\([^)]*\)", "]", prose)  # link targets
+    prose = re.sub(r"[^.\n]*(?:\n[^.\n]+)*\{cite\}[^.]*\.", "", prose)  # a sentence that cites its source
+    found += [("text", n) for n in NUMBER.findall(prose)]
+    return found
+
+
+def code_literals(text):
+    literals = set()
+    for cell in CODE_CELL.findall(FRONT_MATTER.sub("", text)):
+        literals.update(re.findall(r"\d+\.\d+|\d+", CAPTION.sub("", cell)))
+    return literals
+
+
+@pytest.mark.parametrize("page", book_pages(), ids=lambda path: path.stem)
+def test_stated_numbers_come_from_the_code(page):
+    text = page.read_text()
+    literals = code_literals(text) | allowed_versions()
+    typed = [(where, n) for where, n in stated_numbers(text) if n.rstrip(" %") not in literals]
+    assert not typed, (
+        f"{page.name} states numbers that no code cell sets or glues: {typed}; "
+        "take them from the cell with myst_nb.glue and {glue:text}, or say them without the number"
+    )
+
+
+def test_the_check_finds_a_typed_number():
+    page = (
+        "---\nkernelspec: {}\n---\n\nThe error drops to 9.4 mm, or 12 %.\n\n"
+        "```{code-cell} ipython3\n---\nmystnb:\n  figure:\n    caption: |\n      Error 6.3 mm with sigma 0.15.\n"
+        "    name: fig-x\n---\nsigma = 0.15\n```\n\nWe glue {glue:text}`error` and set sigma to 0.15.\n"
+    )
+    stated = stated_numbers(page)
+    assert ("text", "9.4") in stated and ("text", "12 %") in stated and ("caption", "6.3") in stated
+    assert "0.15" in code_literals(page) and "6.3" not in code_literals(page)
+    assert not any(n in ("0.13", "7.5 %") for _, n in stated)  # front matter, a cited sentence
