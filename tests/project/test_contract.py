@@ -46,3 +46,23 @@ def test_book_states_the_points_the_grader_gives(page, points, keyword, referenc
     assert sum(t["max_score"] for t in selected) == points, (
         f"{page} says {points} points for -k {keyword!r}, the grader gives {sum(t['max_score'] for t in selected)}"
     )
+
+
+CONTRACT = REPO_ROOT.parent / "shared" / "course-api.md"
+
+
+def _general_rules(text):
+    """The bullets of the contract's general rules, whitespace-normalised."""
+    block = text.split("General rules, for every function below:", 1)[-1]
+    block = re.split(r"\n(?:## |The graded functions|What each function)", block, maxsplit=1)[0]
+    return [" ".join(item.split()) for item in re.split(r"\n- ", "\n" + block.strip()) if item.strip()]
+
+
+@pytest.mark.skipif(not CONTRACT.exists(), reason="../shared/course-api.md is not beside this clone")
+def test_the_exercise_api_page_states_the_contracts_general_rules():
+    contract = _general_rules(CONTRACT.read_text())
+    page = (REPO_ROOT / "book" / "exercise_api.md").read_text()
+    introduction = "Its general rules,\nwhich hold for every function, are these:"
+    page_rules = _general_rules(page.replace(introduction, "General rules, for every function below:"))
+    assert len(contract) >= 5
+    assert page_rules == contract, "book/exercise_api.md must repeat the contract's general rules word for word"
