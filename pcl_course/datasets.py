@@ -29,6 +29,7 @@ from pcl_course.validation import check_choice, check_integer, check_rng
 
 __all__ = [
     "SHAPE_NAMES",
+    "MODELNET40_NAMES",
     "make_shape",
     "normalize_unit_sphere",
     "make_mini_modelnet",
@@ -58,6 +59,17 @@ SHAPE_NAMES = (
     "mug",
     "bottle",
 )
+
+
+# The 40 categories of ModelNet40 (Wu et al., 2015), in the data set's order. Each is a
+# procedural object here: six are shared with SHAPE_NAMES (cup is the mug).
+MODELNET40_NAMES = (
+    "airplane", "bathtub", "bed", "bench", "bookshelf", "bottle", "bowl", "car", "chair", "cone",
+    "cup", "curtain", "desk", "door", "dresser", "flower_pot", "glass_box", "guitar", "keyboard", "lamp",
+    "laptop", "mantel", "monitor", "night_stand", "person", "piano", "plant", "radio", "range_hood", "sink",
+    "sofa", "stairs", "stool", "table", "tent", "toilet", "tv_stand", "vase", "wardrobe", "xbox",
+)  # fmt: skip
+_ALL_SHAPES = tuple(dict.fromkeys(SHAPE_NAMES + MODELNET40_NAMES))
 
 
 # --- primitives: uniform surface samples in a local frame -----------------
@@ -306,6 +318,191 @@ def _shape_parts(name, jitter):
         parts.append(_Part("frustum", (radius, 0.08, shoulder), None, (0.0, 0.0, body)))
         parts += _cylinder(0.08, neck, base=(0.0, 0.0, body + shoulder), bottom=False)
         return parts
+    return _modelnet_parts(name, j)
+
+
+def _open_box(size, center=(0.0, 0.0, 0.0)):
+    """An axis-aligned box without its top face (a tub, a basin)."""
+    top = center[2] + size[2] / 2
+    return [part for part in _box(size, center) if not (part.rotation is None and np.isclose(part.offset[2], top))]
+
+
+def _legs(width, depth, height, thickness=0.04):
+    """Four square legs under a ``width x depth`` top, from z = 0 to ``height``."""
+    parts = []
+    for sx in (-1, 1):
+        for sy in (-1, 1):
+            at = (sx * (width - thickness) / 2, sy * (depth - thickness) / 2, height / 2)
+            parts += _box((thickness, thickness, height), at)
+    return parts
+
+
+_ALONG_X, _ALONG_Y = _rotation("y", np.pi / 2), _rotation("x", -np.pi / 2)  # turn +z to +x, to +y
+
+
+def _modelnet_parts(name, j):
+    """The parts of one of the ModelNet40 categories the primitives above do not already cover."""
+    if name == "bathtub":
+        return _open_box((j(1.6), j(0.75), j(0.55)), (0.0, 0.0, 0.3))
+    if name == "bed":
+        length, width = j(2.0), j(1.4)
+        parts = _box((length, width, 0.2), (0.0, 0.0, 0.2)) + _box((length, width, j(0.22)), (0.0, 0.0, 0.41))
+        return parts + _box((0.08, width, j(0.9)), (-length / 2, 0.0, 0.45)) + _legs(length, width, 0.1)
+    if name == "bench":
+        length = j(1.5)
+        parts = _box((length, j(0.4), 0.06), (0.0, 0.0, 0.45))
+        return parts + [q for sx in (-1, 1) for q in _box((0.06, 0.38, 0.42), (sx * (length / 2 - 0.1), 0.0, 0.21))]
+    if name == "bookshelf":
+        width, depth, height = j(0.8), j(0.3), j(1.8)
+        parts = [q for sx in (-1, 1) for q in _box((0.03, depth, height), (sx * width / 2, 0.0, height / 2))]
+        parts += _box((width, 0.01, height), (0.0, -depth / 2, height / 2))
+        for z in np.linspace(0.02, height - 0.02, 5):
+            parts += _box((width, depth, 0.03), (0.0, 0.0, z))
+        return parts
+    if name == "bowl":
+        return [_Part("frustum", (j(0.25), j(0.5), j(0.25))), _Part("disk", (j(0.25),), _FLIP)]
+    if name == "car":
+        length, width = j(2.0), j(0.9)
+        parts = _box((length, width, 0.45), (0.0, 0.0, 0.45)) + _box((j(1.0), width - 0.1, 0.35), (-0.1, 0.0, 0.85))
+        for sx in (-1, 1):
+            for sy in (-1, 1):
+                parts += _cylinder(0.2, 0.15, base=(sx * 0.65, sy * width / 2 - (0.15 if sy > 0 else 0), 0.2),
+                                   rotation=_ALONG_Y)  # fmt: skip
+        return parts
+    if name == "cup":
+        return _shape_parts("mug", j)
+    if name == "curtain":
+        width, height = j(1.6), j(2.0)
+        parts = [_Part("rectangle", ((width / 4, height),), _rotation("z", a) @ _ALONG_Y, (x, 0.0, height / 2))
+                 for x, a in zip(np.linspace(-0.375, 0.375, 4) * width, (0.35, -0.35, 0.35, -0.35))]  # fmt: skip
+        return parts + _cylinder(0.02, width * 1.1, base=(-width * 0.55, 0.0, height + 0.03), rotation=_ALONG_X)
+    if name == "desk":
+        width, depth, height = j(1.4), j(0.7), j(0.75)
+        parts = _box((width, depth, 0.04), (0.0, 0.0, height - 0.02))
+        pedestal = (0.4, depth - 0.05, height - 0.04)
+        return parts + [q for sx in (-1, 1) for q in _box(pedestal, (sx * (width / 2 - 0.2), 0.0, pedestal[2] / 2))]
+    if name == "door":
+        width, height = j(0.9), j(2.0)
+        return _box((width, 0.05, height), (0.0, 0.0, height / 2)) + [
+            _Part("sphere", (0.04,), None, (width / 2 - 0.1, 0.07, height / 2))
+        ]
+    if name == "dresser":
+        width, depth, height = j(1.2), j(0.5), j(0.9)
+        parts = _box((width, depth, height), (0.0, 0.0, 0.1 + height / 2)) + _legs(width, depth, 0.1)
+        for z in np.linspace(0.25, height - 0.05, 3):
+            parts += _box((width - 0.1, 0.02, 0.2), (0.0, depth / 2 + 0.01, z))
+        return parts
+    if name == "flower_pot":
+        radius, height = j(0.3), j(0.35)
+        parts = [_Part("frustum", (radius * 0.7, radius, height)), _Part("disk", (radius * 0.7,), _FLIP)]
+        return parts + [_Part("ellipsoid", ((radius * 1.1, radius * 1.1, j(0.3)),), None, (0.0, 0.0, height + 0.2))]
+    if name == "glass_box":
+        side = j(0.6)
+        return _box((side, side, j(0.6)), (0.0, 0.0, 0.3)) + _box((side * 0.9, side * 0.9, 0.02), (0.0, 0.0, 0.3))
+    if name == "guitar":
+        parts = [
+            _Part("ellipsoid", ((j(0.4), j(0.3), 0.08),)),
+            _Part("ellipsoid", ((0.3, 0.23, 0.08),), None, (0.45, 0, 0)),
+        ]
+        return parts + _box((j(0.9), 0.07, 0.04), (1.1, 0.0, 0.0)) + _box((0.18, 0.1, 0.03), (1.63, 0.0, 0.0))
+    if name == "keyboard":
+        width, depth = j(0.45), j(0.15)
+        parts = _box((width, depth, 0.025), (0.0, 0.0, 0.0125))
+        for x in np.linspace(-width / 2 + 0.03, width / 2 - 0.03, 12):
+            for y in np.linspace(-depth / 2 + 0.025, depth / 2 - 0.025, 4):
+                parts += _box((0.026, 0.026, 0.01), (x, y, 0.03))
+        return parts
+    if name == "laptop":
+        width, depth = j(0.34), j(0.24)
+        parts = _box((width, depth, 0.02), (0.0, 0.0, 0.01))
+        screen = _box((width, 0.01, depth), (0.0, 0.0, depth / 2))
+        return parts + _placed(screen, (0.0, -depth / 2, 0.02), _rotation("x", -0.25))
+    if name == "mantel":
+        width, height = j(1.6), j(1.2)
+        parts = _box((width, 0.4, 0.08), (0.0, 0.0, height)) + _box((width, 0.45, 0.05), (0.0, 0.02, 0.025))
+        pillar = (0.3, 0.35, height - 0.09)
+        return parts + [q for sx in (-1, 1) for q in _box(pillar, (sx * (width / 2 - 0.15), 0.0, 0.05 + pillar[2] / 2))]
+    if name == "monitor":
+        width, height = j(0.6), j(0.36)
+        parts = _box((width, 0.04, height), (0.0, 0.0, 0.3 + height / 2)) + _box((0.25, 0.18, 0.02), (0.0, 0.0, 0.01))
+        return parts + _cylinder(0.03, 0.3, base=(0.0, 0.0, 0.02), bottom=False, top=False)
+    if name == "night_stand":
+        width = j(0.5)
+        return _box((width, j(0.45), j(0.5)), (0.0, 0.0, 0.35)) + _legs(width, 0.45, 0.1)
+    if name == "person":
+        height = j(1.0)
+        parts = [_Part("ellipsoid", ((0.18, 0.12, 0.3 * height),), None, (0.0, 0.0, 0.95 + 0.3 * height))]
+        parts.append(_Part("sphere", (0.11,), None, (0.0, 0.0, 1.1 + 0.6 * height)))
+        for sy in (-1, 1):
+            parts += _cylinder(0.06, 0.95, base=(0.0, sy * 0.09, 0.0))
+            parts += _cylinder(0.045, 0.6, base=(0.0, sy * 0.24, 0.75 + 0.3 * height))
+        return parts
+    if name == "piano":
+        width, height = j(1.5), j(1.1)
+        parts = _box((width, 0.6, height), (0.0, 0.0, 0.25 + height / 2)) + _box(
+            (width - 0.1, 0.3, 0.06), (0.0, 0.45, 0.72)
+        )
+        return parts + [q for sx in (-1, 1) for q in _box((0.06, 0.06, 0.7), (sx * (width / 2 - 0.1), 0.55, 0.35))]
+    if name == "plant":
+        parts = [_Part("frustum", (0.15, j(0.2), 0.25)), _Part("disk", (0.15,), _FLIP)]
+        parts += _cylinder(0.015, j(0.4), base=(0.0, 0.0, 0.25), bottom=False, top=False)
+        return parts + [_Part("sphere", (j(0.3),), None, (0.0, 0.0, 0.9))]
+    if name == "radio":
+        width, height = j(0.4), j(0.25)
+        parts = _box((width, 0.15, height), (0.0, 0.0, height / 2))
+        parts.append(_Part("disk", (0.07,), _ALONG_Y, (-width / 4, 0.076, height / 2)))
+        return parts + _cylinder(0.006, j(0.35), base=(width / 2 - 0.03, 0.0, height), rotation=_rotation("y", 0.4))
+    if name == "range_hood":
+        width = j(0.9)
+        parts = [_Part("frustum", (width / 2, 0.18, j(0.3)), _rotation("z", np.pi / 4))]
+        return parts + _box((0.3, 0.3, j(0.6)), (0.0, 0.0, 0.6)) + [_Part("disk", (width / 2,), _FLIP)]
+    if name == "sink":
+        parts = _open_box((j(0.6), j(0.45), 0.2), (0.0, 0.0, 0.8)) + _box((0.7, 0.55, 0.7), (0.0, 0.0, 0.35))
+        return parts + _cylinder(0.02, 0.25, base=(0.0, -0.2, 0.9)) + _box((0.03, 0.15, 0.03), (0.0, -0.13, 1.14))
+    if name == "sofa":
+        length, depth = j(2.0), j(0.9)
+        parts = _box((length, depth, 0.4), (0.0, 0.0, 0.2)) + _box(
+            (length, 0.2, j(0.45)), (0.0, -depth / 2 + 0.1, 0.62)
+        )
+        return parts + [q for sx in (-1, 1) for q in _box((0.2, depth, 0.25), (sx * (length / 2 - 0.1), 0.0, 0.52))]
+    if name == "stairs":
+        width, rise, run = j(1.0), j(0.18), j(0.3)
+        return [q for i in range(1, 6) for q in _box((width, run, rise * i), (0.0, run * i, rise * i / 2))]
+    if name == "stool":
+        radius, height = j(0.2), j(0.6)
+        parts = _cylinder(radius, 0.05, base=(0.0, 0.0, height))
+        for a in (0.0, 2 * np.pi / 3, 4 * np.pi / 3):
+            parts += _cylinder(0.02, height, base=(0.7 * radius * np.cos(a), 0.7 * radius * np.sin(a), 0.0), top=False)
+        return parts
+    if name == "tent":
+        length, half, height = j(2.0), j(0.8), j(1.1)
+        slope, angle = np.hypot(half, height), np.arctan2(height, half)
+        parts = [_Part("rectangle", ((length, slope),), _rotation("x", -sy * angle), (0.0, sy * half / 2, height / 2))
+                 for sy in (-1, 1)]  # fmt: skip
+        return parts + [_Part("rectangle", ((length, 2 * half),), _FLIP)]
+    if name == "toilet":
+        parts = [_Part("ellipsoid", ((j(0.2), j(0.25), 0.15),), None, (0.0, 0.05, 0.4))]
+        parts += _cylinder(0.12, 0.3, top=False)
+        return parts + _box((0.4, 0.18, j(0.35)), (0.0, -0.3, 0.6))
+    if name == "tv_stand":
+        width, depth = j(1.4), j(0.4)
+        return _box((width, depth, j(0.45)), (0.0, 0.0, 0.33)) + _legs(width, depth, 0.1)
+    if name == "vase":
+        radius, body = j(0.3), j(0.4)
+        parts = [_Part("frustum", (radius / 2, radius, body * 0.6)), _Part("disk", (radius / 2,), _FLIP)]
+        parts.append(_Part("frustum", (radius, radius / 3, body), None, (0.0, 0.0, body * 0.6)))
+        return parts + _cylinder(radius / 3, j(0.2), base=(0.0, 0.0, body * 1.6), bottom=False, top=False)
+    if name == "wardrobe":
+        width, depth, height = j(1.0), j(0.6), j(2.0)
+        parts = _box((width, depth, height), (0.0, 0.0, 0.05 + height / 2)) + _legs(width, depth, 0.05)
+        return parts + [
+            q for sx in (-1, 1) for q in _box((0.02, 0.03, 0.3), (sx * 0.06, depth / 2 + 0.015, height / 2))
+        ]
+    if name == "xbox":
+        width, depth, height = j(0.3), j(0.26), j(0.08)
+        return _box((width, depth, height), (0.0, 0.0, height / 2)) + [
+            _Part("disk", (0.04,), None, (width / 4, 0.0, height + 1e-3))
+        ]
     raise AssertionError(name)
 
 
@@ -328,7 +525,9 @@ def make_shape(name, n_points=2048, noise=0.0, rng=None, variation=0.0):
         ``cylinder``, ``cone``, ``torus``, ``plane``, ``ellipsoid`` and the
         composite objects ``chair``, ``table``, ``lamp``, ``airplane``,
         ``mug``, ``bottle`` (unions of primitive surfaces; as in many CAD
-        models, some parts overlap and their hidden faces are sampled too).
+        models, some parts overlap and their hidden faces are sampled too),
+        or one of the 40 categories of :data:`MODELNET40_NAMES` (``bathtub``
+        ... ``xbox``), built the same way.
     n_points : int, default 2048
     noise : float, default 0.0
         Standard deviation of isotropic Gaussian noise added to the points
@@ -344,7 +543,7 @@ def make_shape(name, n_points=2048, noise=0.0, rng=None, variation=0.0):
     normals : ndarray of float64, shape (n_points, 3)
         Outward unit normals of the noise-free surface at each sample.
     """
-    check_choice(name, "name", SHAPE_NAMES)
+    check_choice(name, "name", _ALL_SHAPES)
     n_points = check_integer(n_points, "n_points", low=0)
     if not np.isfinite(noise) or noise < 0:
         raise ValueError(f"noise must be a non-negative number, got {noise!r}")

@@ -15,7 +15,7 @@ from pcl_course.io import (
 )
 
 
-@pytest.mark.parametrize("name", datasets.SHAPE_NAMES)
+@pytest.mark.parametrize("name", sorted(set(datasets.SHAPE_NAMES + datasets.MODELNET40_NAMES)))
 def test_shape_has_requested_size_and_unit_normals(name):
     points, normals = datasets.make_shape(name, 1500, rng=0)
     assert points.shape == normals.shape == (1500, 3)
@@ -35,6 +35,22 @@ def test_shape_is_deterministic_given_its_seed(name):
 
 def test_there_are_at_least_twelve_categories():
     assert len(set(datasets.SHAPE_NAMES)) >= 12
+
+
+def test_the_modelnet40_categories_are_all_there_and_distinct():
+    assert len(set(datasets.MODELNET40_NAMES)) == len(datasets.MODELNET40_NAMES) == 40
+    assert datasets.MODELNET40_NAMES == tuple(sorted(datasets.MODELNET40_NAMES))  # the data set's order
+    sizes = {name: np.ptp(datasets.make_shape(name, 800, rng=0)[0], axis=0) for name in datasets.MODELNET40_NAMES}
+    shapes = {name: tuple(np.round(np.sort(size / size.max()), 2)) for name, size in sizes.items()}
+    assert len(set(shapes.values())) >= 38, "the categories must be distinct objects, not copies of one shape"
+
+
+def test_a_mini_modelnet40_has_the_real_files_and_names(tmp_path):
+    root = datasets.make_mini_modelnet(tmp_path, n_per_class=2, n_test_per_class=1, n_points=64,
+                                       classes=datasets.MODELNET40_NAMES)  # fmt: skip
+    assert (root / "modelnet40_shape_names.txt").read_text().split() == list(datasets.MODELNET40_NAMES)
+    train = datasets.load_modelnet(root, split="train")
+    assert sorted({o["label"] for o in train}) == list(datasets.MODELNET40_NAMES)
 
 
 def test_sphere_normals_are_exact_radial_directions():
