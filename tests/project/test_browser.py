@@ -86,3 +86,20 @@ def test_page_in_a_real_browser(name, site, browser):
     tab.close()
     assert not errors, f"{name}: console errors {errors}"
     assert not remote, f"{name}: requests off this machine {remote[:3]}"
+
+
+def test_long_code_lines_wrap_and_legends_clear_the_mode_bar(site, browser):
+    tab = browser.new_page(viewport={"width": 1280, "height": 900})
+    tab.goto(f"{site}/book/downsampling.html", wait_until="load")
+    tab.wait_for_function("document.querySelectorAll('.js-plotly-plot .legend').length > 0", timeout=30000)
+    code = tab.locator("div.cell_input pre").first
+    assert code.evaluate("e => getComputedStyle(e).whiteSpace") == "pre-wrap"
+    assert code.evaluate("e => e.scrollWidth <= e.clientWidth + 1"), "a code cell scrolls sideways: its lines are cut"
+    plot = tab.locator(".js-plotly-plot").first
+    plot.hover()  # the mode bar shows on hover
+    legend, modebar = plot.locator(".legend").bounding_box(), plot.locator(".modebar").bounding_box()
+    tab.close()
+    assert legend and modebar
+    overlap_x = min(legend["x"] + legend["width"], modebar["x"] + modebar["width"]) - max(legend["x"], modebar["x"])
+    overlap_y = min(legend["y"] + legend["height"], modebar["y"] + modebar["height"]) - max(legend["y"], modebar["y"])
+    assert overlap_x <= 0 or overlap_y <= 0, f"the Plotly legend {legend} overlaps the mode bar {modebar}"
