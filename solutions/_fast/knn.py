@@ -157,7 +157,7 @@ def _point_gap_sq(lower, upper, node, points, q):
     return gap
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _offer_near(points, tree, start, slots, seen_from, seen_to, skip_self, scratch):
     """Offer every leaf that could improve one of the queries ``start + slots``.
 
@@ -204,7 +204,7 @@ def _offer_near(points, tree, start, slots, seen_from, seen_to, skip_self, scrat
             radius_sq = max(radius_sq, heaps.distance_sq[slot, 0])
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _leaf_neighbours(points, tree, leaf, skip_self, scratch):
     """Fill the heaps with the k nearest of every query of ``leaf``; returns the leaf's rows ``(start, stop)``.
 
@@ -245,7 +245,7 @@ def _leaf_neighbours(points, tree, leaf, skip_self, scratch):
 Scratch = namedtuple("Scratch", ["heaps", "stack", "box_lower", "box_upper", "slots", "first_k_sq"])
 
 
-@njit(cache=True, nogil=True, inline="always")
+@njit(cache=True, nogil=True)
 def _scratch(tree, k):
     """A :data:`Scratch` for leaves of ``tree.leaf_size`` queries and ``k`` neighbours."""
     size = tree.leaf_size
