@@ -231,46 +231,28 @@ def _unoriented_same(a, b, arguments):
     return not isinstance(a, _Wrong) and _normals_same(a, b, arguments)
 
 
-def _small_neighbourhoods_same(a, b, arguments):
-    if isinstance(b, _Wrong):
-        try:
-            normals_a = np.asarray(a[0], dtype=float)
-            normals_b = np.asarray(b.truth[0], dtype=float)
-        except Exception:
-            return False
-        missing = np.isnan(normals_b).any(axis=1)
-        if normals_a.shape != normals_b.shape or not missing.any():
-            return False
-        rest = _agreement(
-            (a[0][~missing], a[1][~missing]),
-            (normals_b[~missing], b.truth[1][~missing]),
-            {key: value for key, value in arguments.items() if key != "points"},
-            oriented=arguments.get("viewpoint") is not None,
-        )
-        return bool(np.isfinite(normals_a[missing]).all()) and rest >= 0.98
-    return not isinstance(a, _Wrong) and _normals_same(a, b, arguments)
+def _wrong_only_where(where_of, wrong_there):
+    """A mistake that departs from the truth only at some points: its ``(predict, same)`` pair.
 
+    ``where_of(points, k, radius, viewpoint, truth)`` marks the points where
+    the mistake gives another answer; ``wrong_there(normals, curvature)``
+    tells whether a submission's answer at those points is the mistake's.
+    Everywhere else the submission must be right.
+    """
 
-def _with_small_neighbourhoods(points, k=30, radius=None, viewpoint=None):
-    truth = normals(points, k, radius, viewpoint)
-    return _Wrong(truth) if np.isnan(truth[0]).any() else None
+    def predict(points, k=30, radius=None, viewpoint=None):
+        truth = normals(points, k, radius, viewpoint)
+        where = where_of(points, k, radius, viewpoint, truth)
+        return _Wrong(truth, where) if where.any() else None
 
-
-def _with_zero_traces(points, k=30, radius=None, viewpoint=None):
-    truth = normals(points, k, radius, viewpoint)
-    nan_curvature = np.isnan(normals(points, k, radius, viewpoint, zero_trace_nan=True)[1])
-    where = nan_curvature & ~np.isnan(truth[1])  # every neighbour at the same spot: l = 0 and trace = 0
-    return _Wrong(truth, where) if where.any() else None
-
-
-def _zero_traces_same(a, b, arguments):
-    """A NaN curvature where the trace is 0, right elsewhere (any unit normal is right at such points)."""
-    if isinstance(b, _Wrong):
+    def same(a, b, arguments):
+        if not isinstance(b, _Wrong):
+            return not isinstance(a, _Wrong) and _normals_same(a, b, arguments)
         try:
             normals_a, curvature_a = (np.asarray(x, dtype=float) for x in a)
         except Exception:
             return False
-        if curvature_a.shape != b.truth[1].shape or normals_a.shape != b.truth[0].shape:
+        if normals_a.shape != b.truth[0].shape or curvature_a.shape != b.truth[1].shape:
             return False
         rest = ~b.where
         agreement = _agreement(
@@ -279,8 +261,26 @@ def _zero_traces_same(a, b, arguments):
             {key: value for key, value in arguments.items() if key != "points"},
             oriented=arguments.get("viewpoint") is not None,
         )
-        return bool(np.isnan(curvature_a[b.where]).all()) and agreement >= 0.98
-    return not isinstance(a, _Wrong) and _normals_same(a, b, arguments)
+        return bool(wrong_there(normals_a[b.where], curvature_a[b.where])) and agreement >= 0.98
+
+    return predict, same
+
+
+def _nan_in_truth(points, k, radius, viewpoint, truth):
+    return np.isnan(truth[0]).any(axis=1)  # fewer than 3 neighbours
+
+
+def _zero_trace(points, k, radius, viewpoint, truth):
+    nan_curvature = np.isnan(normals(points, k, radius, viewpoint, zero_trace_nan=True)[1])
+    return nan_curvature & ~np.isnan(truth[1])  # every neighbour at the same spot: l = 0 and trace = 0
+
+
+_with_small_neighbourhoods, _small_neighbourhoods_same = _wrong_only_where(
+    _nan_in_truth, lambda normals_there, curvature_there: np.isfinite(normals_there).all()
+)
+_with_zero_traces, _zero_traces_same = _wrong_only_where(
+    _zero_trace, lambda normals_there, curvature_there: np.isnan(curvature_there).all()
+)
 
 
 def _changed(**changes):
