@@ -360,16 +360,28 @@ def _become_subreaper():
 
 
 def _processes():
-    """(pid, parent pid, process group, real uid) of every living process (no zombies)."""
+    """(pid, parent pid, process group, real uid) of every living process (no zombies).
+
+    Called after every graded call, so plain ``os`` calls rather than
+    ``pathlib``: one open, read and fstat per process (a third of the time).
+    The stat file belongs to the process's uid, as its /proc directory does.
+    """
     found = []
-    for entry in Path("/proc").glob("[0-9]*"):
-        try:
-            fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
-            uid = entry.stat().st_uid
-        except (OSError, IndexError):
-            continue
-        if fields[0] != "Z":
-            found.append((int(entry.name), int(fields[1]), int(fields[2]), uid))
+    with os.scandir("/proc") as entries:
+        for entry in entries:
+            if not entry.name.isdigit():
+                continue
+            try:
+                handle = os.open(f"/proc/{entry.name}/stat", os.O_RDONLY)
+                try:
+                    stat, uid = os.read(handle, 4096), os.fstat(handle).st_uid
+                finally:
+                    os.close(handle)
+                fields = stat.rsplit(b")", 1)[1].split()
+            except (OSError, IndexError):
+                continue
+            if fields[0] != b"Z":
+                found.append((int(entry.name), int(fields[1]), int(fields[2]), uid))
     return found
 
 
