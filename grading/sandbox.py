@@ -46,6 +46,7 @@ import io
 import json
 import os
 import pickle
+import re
 import resource
 import select
 import shutil
@@ -359,12 +360,18 @@ def _become_subreaper():
         pass
 
 
+_STATUS_FIELDS = re.compile(rb"^(State|PPid|Uid|NSpgid):\s*(\S+)", re.MULTILINE)  # Uid: the real one first
+
+
 def _processes():
     """(pid, parent pid, process group, real uid) of every living process (no zombies).
 
-    Called after every graded call, so plain ``os`` calls rather than
-    ``pathlib``: one open, read and fstat per process (a third of the time).
-    The stat file belongs to the process's uid, as its /proc directory does.
+    From /proc/PID/status, whose ``Uid:`` line holds the real uid: the owner
+    of a process's /proc files is root once it makes itself non-dumpable
+    (``prctl(PR_SET_DUMPABLE, 0)``), which would hide it from
+    :func:`kill_uid`. Called after every graded call, so plain ``os`` calls
+    rather than ``pathlib``. The status file escapes newlines in the
+    process's name, so a name cannot forge a line.
     """
     found = []
     with os.scandir("/proc") as entries:
@@ -372,16 +379,18 @@ def _processes():
             if not entry.name.isdigit():
                 continue
             try:
-                handle = os.open(f"/proc/{entry.name}/stat", os.O_RDONLY)
+                handle = os.open(f"/proc/{entry.name}/status", os.O_RDONLY)
                 try:
-                    stat, uid = os.read(handle, 4096), os.fstat(handle).st_uid
+                    status = os.read(handle, 1 << 16)
                 finally:
                     os.close(handle)
-                fields = stat.rsplit(b")", 1)[1].split()
-            except (OSError, IndexError):
+                fields = dict(_STATUS_FIELDS.findall(status, status.find(b"\n")))  # after the Name line
+                state, parent, uid = fields[b"State"], int(fields[b"PPid"]), int(fields[b"Uid"])
+                group = int(fields.get(b"NSpgid", -1))
+            except (OSError, KeyError, IndexError, ValueError):
                 continue
-            if fields[0] != b"Z":
-                found.append((int(entry.name), int(fields[1]), int(fields[2]), uid))
+            if state != b"Z":
+                found.append((int(entry.name), parent, group, uid))
     return found
 
 

@@ -6,6 +6,7 @@ import os
 import resource
 import shutil
 import textwrap
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -310,6 +311,55 @@ def test_without_namespaces_the_dedicated_uid_reads_nothing_of_the_grader(tmp_pa
     from grading.sandbox import _processes
 
     assert not [p for p in _processes() if p[3] == uid], "the uid's processes outlive its worker"
+
+
+def _real_uid_holders(uid):
+    """The pids whose real uid is ``uid``, read from /proc/PID/status (not the files' owner)."""
+    found = []
+    for status in Path("/proc").glob("[0-9]*/status"):
+        try:
+            lines = status.read_text().splitlines()
+        except OSError:
+            continue
+        real = [line.split()[1] for line in lines if line.startswith("Uid:")]
+        state = [line.split()[1] for line in lines if line.startswith("State:")]
+        if real == [str(uid)] and state != ["Z"]:
+            found.append(int(status.parent.name))
+    return found
+
+
+@needs_root
+def test_a_process_that_makes_itself_non_dumpable_is_still_seen_and_killed(tmp_path):
+    """A non-dumpable process's /proc files belong to root, whatever its uid."""
+    from grading.sandbox import UID, Isolation, reserve_uid
+
+    uid = reserve_uid()
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "evil.py").write_text(
+        textwrap.dedent(
+            """
+            import ctypes, os, time
+            def hide():
+                ready, done = os.pipe()
+                if os.fork() == 0:
+                    ctypes.CDLL(None).prctl(4, 0, 0, 0, 0)  # PR_SET_DUMPABLE 0
+                    os.write(done, b"x")
+                    time.sleep(60)
+                    os._exit(0)
+                os.read(ready, 1)
+                return 1
+            """
+        )
+    )
+    worker = Worker(stage(package).root, timeout=20, level=Isolation(UID, uid, "test"))
+    try:
+        with pytest.raises(SandboxError, match="processes of its own"):
+            worker.call("evil", "hide", (), {})
+    finally:
+        worker.stop()
+    assert not _real_uid_holders(uid), "the hidden process outlives its worker"
 
 
 def test_the_level_is_named_in_the_results_and_can_be_required(tmp_path):
