@@ -6,7 +6,39 @@ that a sphere looks like a sphere.
 
 import numpy as np
 
-__all__ = ["new_3d_axes", "set_axes_equal", "plot_cloud", "plot_vectors", "depth_panels", "worst_difference_window"]
+__all__ = [
+    "new_3d_axes",
+    "set_axes_equal",
+    "plot_cloud",
+    "plot_vectors",
+    "cloud_trace",
+    "vectors_trace",
+    "interactive_figure",
+    "show_interactive",
+    "depth_panels",
+    "worst_difference_window",
+    "cloud_gallery",
+    "principal_axes_gallery",
+    "angular_error_gallery",
+    "scan_top_view",
+    "rayleigh_curve",
+    "rotating_direction",
+    "eigen_images",
+    "reconstruction_figure",
+    "labelled_codes",
+    "lifting_figure",
+    "component_scatter",
+    "curves",
+    "error_against_radius",
+    "precision_recall_panels",
+    "samples_top_view",
+    "highlighted_samples",
+    "sampler_gallery",
+    "accuracy_against_samples",
+    "outlier_filters",
+    "filtered_images",
+    "box_slices",
+]
 
 
 def new_3d_axes(fig, *position, title=None, elev=25, azim=-60):
@@ -207,3 +239,525 @@ def worst_difference_window(error_a, error_b, valid, size):
     top = int(np.clip(row - height // 2, 0, gain.shape[0] - height))
     left = int(np.clip(column - width // 2, 0, gain.shape[1] - width))
     return slice(top, top + height), slice(left, left + width)
+
+
+# --- the book's figures ------------------------------------------------------
+#
+# One function per kind of figure, so that a page shows what it computes and
+# one line that draws it. Each draws a matplotlib figure and shows it.
+
+
+def _subplots(rows, columns, figsize, **kwargs):
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(rows, columns, figsize=figsize, **kwargs)
+
+
+def _show():
+    import matplotlib.pyplot as plt
+
+    plt.show()
+
+
+def cloud_gallery(panels, columns, figsize, size=1.0, axis_labels=False, axis_off=True):
+    """3-D views of several clouds in a grid, filled row by row.
+
+    Parameters
+    ----------
+    panels : list of (str, array_like of shape (N, 3))
+        Titles and clouds.
+    columns : int
+    figsize : (float, float)
+        Inches.
+    size : float or sequence of float
+        Marker area in points^2, one for all panels or one per panel.
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=figsize)
+    rows = -(-len(panels) // columns)
+    sizes = np.broadcast_to(np.asarray(size, dtype=float), (len(panels),))
+    for i, ((title, points), marker_size) in enumerate(zip(panels, sizes)):
+        ax = new_3d_axes(fig, rows, columns, i + 1, title=title)
+        plot_cloud(ax, points, size=marker_size, axis_labels=axis_labels)
+        if axis_off:
+            ax.set_axis_off()
+    _show()
+
+
+def principal_axes_gallery(panels, columns, figsize, color="0.6", size=0.5, width=2.5, axis_off=False):
+    """Clouds with their principal axes, two standard deviations long (red, green, blue).
+
+    Parameters
+    ----------
+    panels : list of (str, ndarray of shape (N, 3), ndarray of shape (3,), ndarray of shape (3, 3))
+        Title, points, eigenvalues (decreasing) and eigenvectors (columns).
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=figsize)
+    rows = -(-len(panels) // columns)
+    for i, (title, points, values, vectors) in enumerate(panels):
+        ax = new_3d_axes(fig, rows, columns, i + 1, title=title)
+        plot_cloud(ax, points, color=color, size=size, axis_labels=False)
+        for k, axis_color in enumerate("rgb"):
+            plot_vectors(ax, points.mean(axis=0), vectors[:, k], length=2 * np.sqrt(values[k]), color=axis_color,
+                         lw=width)  # fmt: skip
+        if axis_off:
+            ax.set_axis_off()
+    _show()
+
+
+def angular_error_gallery(panels, figsize, size=3.0, arrows=None, axis_off=False, clip=30.0):
+    """Clouds coloured by the angular error of their normals, with one colour bar.
+
+    Parameters
+    ----------
+    panels : list of (str, ndarray of shape (N, 3), ndarray of shape (N,))
+        Title, points and the error at each point (degrees).
+    arrows : list of (ndarray of shape (M, 3), ndarray of shape (M, 3)), optional
+        Per panel, origins and unit vectors drawn as short blue lines.
+    clip : float
+        Top of the colour scale (degrees); larger errors show as ``clip``.
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=figsize)
+    for i, (title, points, error) in enumerate(panels):
+        ax = new_3d_axes(fig, 1, len(panels), i + 1, title=title)
+        artist = plot_cloud(ax, points, color=np.clip(error, 0, clip), size=size, cmap="magma",
+                            axis_labels=not axis_off, vmin=0, vmax=clip)  # fmt: skip
+        if arrows is not None:
+            origins, vectors = arrows[i]
+            plot_vectors(ax, origins, vectors, length=0.08, color="tab:blue", lw=0.6)
+        if axis_off:
+            ax.set_axis_off()
+    fig.colorbar(artist, ax=fig.axes, shrink=0.7, label=f"angular error (degrees, clipped at {clip:g})")
+    _show()
+
+
+def scan_top_view(points, labels, is_outlier, class_names, colors=("0.6", "tab:blue", "tab:orange", "k",
+                                                                     "tab:green", "tab:purple")):  # fmt: skip
+    """Bird's-eye view of a lidar scan coloured by class, its spurious returns in red.
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, 3)
+        Metres.
+    labels : ndarray of int, shape (N,)
+        Indices into ``class_names``.
+    is_outlier : ndarray of bool, shape (N,)
+    """
+    colors = np.asarray(colors)
+    fig, ax = _subplots(1, 1, (8, 8))
+    inliers = ~is_outlier
+    ax.scatter(*points[inliers, :2].T, s=0.2, c=colors[labels[inliers]], linewidths=0)
+    ax.scatter(*points[is_outlier, :2].T, s=3, c="red", linewidths=0, label="spurious returns")
+    for label, color in zip(class_names, colors):
+        ax.scatter([], [], c=color, s=20, label=label)
+    ax.set(xlim=(-60, 60), ylim=(-60, 60), aspect="equal", xlabel="x (m)", ylabel="y (m)")
+    ax.legend(loc="upper right", markerscale=1)
+    _show()
+
+
+def _angle_degrees(vector):
+    """The angle of a 2-D direction in [0, 180) degrees (a direction and its opposite are one)."""
+    return np.degrees(np.arctan2(vector[1], vector[0])) % 180
+
+
+def rayleigh_curve(angles, quotient, eigenvalues, eigenvectors):
+    """The Rayleigh quotient along the unit circle, with the eigenvalues and eigenvectors' angles.
+
+    Parameters
+    ----------
+    angles : ndarray of shape (M,)
+        Radians.
+    quotient : ndarray of shape (M,)
+    eigenvalues : ndarray of shape (2,)
+    eigenvectors : ndarray of shape (2, 2)
+        Columns.
+    """
+    fig, ax = _subplots(1, 1, (7, 3.5))
+    ax.plot(np.degrees(angles), quotient, label=r"$R_A(\cos\theta, \sin\theta)$")
+    for value, vector in zip(eigenvalues, eigenvectors.T):
+        ax.axhline(value, ls="--", c="gray")
+        ax.axvline(_angle_degrees(vector), ls=":", c="gray")
+    ax.set(xlabel=r"$\theta$ (degrees)", ylabel="Rayleigh quotient")
+    ax.legend()
+    _show()
+
+
+def rotating_direction(cloud, angles, variance, eigenvectors, shown_degrees=(0, 30, 60, 90, 120, 150)):
+    """A 2-D cloud with some directions, and the variance along a direction against its angle.
+
+    Parameters
+    ----------
+    cloud : ndarray of shape (N, 2)
+    angles : ndarray of shape (M,)
+        Radians.
+    variance : ndarray of shape (M,)
+        Variance of the coordinates along each angle's direction.
+    eigenvectors : ndarray of shape (2, 2)
+        The covariance's eigenvectors (columns), marked as dashed lines.
+    """
+    fig, (left, right) = _subplots(1, 2, (11, 4), layout="constrained")
+    left.scatter(*cloud.T, s=5, color="0.6")
+    for a in np.deg2rad(shown_degrees):
+        left.plot([0, 2.5 * np.cos(a)], [0, 2.5 * np.sin(a)], lw=1)
+    left.set(aspect="equal", title="the cloud and some directions")
+    right.plot(np.degrees(angles), variance)
+    for vector in eigenvectors.T:
+        right.axvline(_angle_degrees(vector), ls="--", color="k")
+    right.set(xlabel="angle theta of z (degrees)", ylabel="variance of the coordinates z.x~")
+    _show()
+
+
+def eigen_images(mean, eigenvectors, share, image_shape, count=9):
+    """The mean image and the first ``count`` principal directions as images (red adds, blue removes).
+
+    Parameters
+    ----------
+    mean : ndarray of shape (P,)
+    eigenvectors : ndarray of shape (P, K)
+        Columns, in decreasing order of variance.
+    share : ndarray of shape (K,)
+        Share of the variance along each direction, shown in its title.
+    image_shape : (int, int)
+    """
+    fig, axes = _subplots(1, count + 1, (13, 1.8))
+    axes[0].imshow(mean.reshape(image_shape), cmap="gray_r")
+    axes[0].set_title("mean")
+    for k, ax in enumerate(axes[1:]):
+        v = eigenvectors[:, k].reshape(image_shape)
+        ax.imshow(v, cmap="RdBu_r", vmin=-np.abs(v).max(), vmax=np.abs(v).max())
+        ax.set_title(f"u{k + 1}: {share[k]:.1%}")
+    for ax in axes:
+        ax.set_axis_off()
+    _show()
+
+
+def reconstruction_figure(kept_share, rows, image_shape, vmax):
+    """The variance kept against k (left), and rows of images decoded from k components (right).
+
+    Parameters
+    ----------
+    kept_share : ndarray of shape (K,)
+        Share of the variance kept by the first 1, 2, ..., K components.
+    rows : dict of str to ndarray of shape (M, P)
+        Row label to M flattened images.
+    image_shape : (int, int)
+    vmax : float
+        Top of the grey scale.
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(13, 4))
+    ax = fig.add_subplot(1, 3, 1)
+    ax.plot(np.arange(1, len(kept_share) + 1), kept_share, marker=".")
+    ax.set(xlabel="number of components k", ylabel="share of variance kept", ylim=(0, 1.02))
+    ax.grid(alpha=0.3)
+    columns = len(next(iter(rows.values())))
+    grid = fig.add_gridspec(len(rows), columns, left=0.4, right=0.98)
+    for row, (label, images) in enumerate(rows.items()):
+        for column, image in enumerate(images):
+            a = fig.add_subplot(grid[row, column])
+            a.imshow(image.reshape(image_shape), cmap="gray_r", vmin=0, vmax=vmax)
+            a.set_xticks([])
+            a.set_yticks([])
+            if column == 0:
+                a.set_ylabel(label, rotation=0, labelpad=18)
+    _show()
+
+
+def labelled_codes(codes, labels):
+    """Points at their first two coordinates, coloured by class, each class's label at its mean."""
+    fig, ax = _subplots(1, 1, (7, 6))
+    scatter = ax.scatter(codes[:, 0], codes[:, 1], c=labels, cmap="tab10", s=8)
+    for label in np.unique(labels):
+        ax.annotate(str(label), codes[labels == label].mean(axis=0), fontsize=16, weight="bold", ha="center",
+                    va="center", bbox=dict(boxstyle="circle", fc="white", alpha=0.8))  # fmt: skip
+    ax.set(xlabel="first principal coordinate", ylabel="second principal coordinate")
+    fig.colorbar(scatter, ax=ax, ticks=np.unique(labels), label="digit")
+    _show()
+
+
+def lifting_figure(points, labels, first_linear, lifted, lifted_coordinates, component):
+    """The circles with their 1st linear PC, the lifted points, and two lifted principal coordinates.
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, 2)
+    labels : ndarray of shape (N,)
+    first_linear : ndarray of shape (N,)
+        Coordinates on the first principal direction of ``points``.
+    lifted : ndarray of shape (N, 3)
+    lifted_coordinates : ndarray of shape (N, 3)
+        Coordinates on the lifted principal directions.
+    component : int
+        The lifted component plotted against the first (0-based).
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(13, 4.2))
+    ax = fig.add_subplot(1, 3, 1)
+    ax.scatter(*points.T, c=labels, cmap="coolwarm", s=8)
+    ax.scatter(first_linear, np.full(len(points), -1.4), c=labels, cmap="coolwarm", s=4, marker="|")
+    ax.set(aspect="equal", title="input and its 1st PC (bottom)")
+    ax = new_3d_axes(fig, 1, 3, 2, title=r"lifted by $\phi$", elev=15)
+    ax.scatter(*lifted.T, c=labels, cmap="coolwarm", s=6)
+    ax = fig.add_subplot(1, 3, 3)
+    ax.scatter(lifted_coordinates[:, 0], lifted_coordinates[:, component], c=labels, cmap="coolwarm", s=8)
+    ax.set(xlabel="1st lifted principal coordinate", ylabel=f"principal coordinate {component + 1}")
+    fig.subplots_adjust(wspace=0.35)
+    _show()
+
+
+def component_scatter(panels, labels):
+    """Points at their first two components, one panel per method, coloured by class.
+
+    Parameters
+    ----------
+    panels : dict of str to ndarray of shape (N, >= 2)
+    labels : ndarray of shape (N,)
+    """
+    fig, axes = _subplots(1, len(panels), (15, 3.8), layout="constrained")
+    for ax, (title, projections) in zip(np.atleast_1d(axes), panels.items()):
+        ax.scatter(*projections[:, :2].T, c=labels, cmap="coolwarm", s=8)
+        ax.set(title=title, xlabel="1st component", ylabel="2nd component")
+    _show()
+
+
+def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vline=None, floor=None,
+           figsize=(7, 4)):  # fmt: skip
+    """Several curves over one x axis, with a legend.
+
+    Parameters
+    ----------
+    x : array_like of shape (M,)
+    values : dict of str to array_like of shape (M,)
+        Legend label to the curve's values.
+    vline : (float, str), optional
+        A dotted vertical line and its legend label.
+    floor : float, optional
+        Values below it are drawn at it (a log scale has no 0).
+    """
+    fig, ax = _subplots(1, 1, figsize)
+    for label, ys in values.items():
+        ys = np.asarray(ys, dtype=float)
+        ax.plot(x, ys if floor is None else np.maximum(ys, floor), marker="o", label=label)
+    if vline is not None:
+        ax.axvline(vline[0], ls=":", c="gray", label=vline[1])
+    ax.set(xlabel=xlabel, ylabel=ylabel, xscale=xscale, yscale=yscale)
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    ax.legend()
+    ax.grid(alpha=0.3, which="both")
+    _show()
+
+
+def error_against_radius(radii, errors, shapes, noises):
+    """Mean angular error against the radius, one panel per shape, one curve per noise level.
+
+    Parameters
+    ----------
+    radii : array_like of shape (M,)
+    errors : dict of (str, float) to array_like of shape (M,)
+        ``errors[shape, noise]``, degrees.
+    """
+    fig, axes = _subplots(1, len(shapes), (12, 4), sharey=True)
+    for ax, shape in zip(axes, shapes):
+        for noise in noises:
+            ax.plot(radii, errors[shape, noise], marker="o", label=f"noise {noise}")
+        ax.set(title=shape, xlabel="radius", xscale="log", yscale="log")
+        ax.grid(alpha=0.3, which="both")
+    axes[0].set_ylabel("mean angular error (degrees)")
+    axes[-1].legend()
+    _show()
+
+
+def precision_recall_panels(panels):
+    """Precision and recall against a parameter, one panel per filter.
+
+    Parameters
+    ----------
+    panels : list of (str, array_like of shape (M,), list of (float, float))
+        The parameter's label, its values and (precision, recall) at each.
+    """
+    fig, axes = _subplots(1, len(panels), (12, 3.8), sharey=True)
+    for ax, (label, xs, pr) in zip(axes, panels):
+        ax.plot(xs, [p for p, _ in pr], marker="o", label="precision")
+        ax.plot(xs, [r for _, r in pr], marker="s", label="recall")
+        ax.set(xlabel=label, ylim=(0, 1.02))
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("share")
+    axes[0].legend()
+    _show()
+
+
+def samples_top_view(points, samples, background_step=10):
+    """Samples of a cloud seen from above (blue), over every ``background_step``-th point (grey).
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, >= 2)
+    samples : dict of str to ndarray of shape (M, >= 2)
+        Panel title to the sampled points.
+    """
+    fig, axes = _subplots(1, len(samples), (12, 4.5), layout="constrained")
+    for ax, (title, sample) in zip(axes, samples.items()):
+        ax.scatter(*points[::background_step, :2].T, s=1, color="0.85")
+        ax.scatter(*sample[:, :2].T, s=10, color="tab:blue")
+        ax.set(aspect="equal", title=title, xticks=[], yticks=[])
+    _show()
+
+
+def highlighted_samples(points, samples, highlight, zlim, background_step=10):
+    """3-D views of samples of a cloud, red where ``highlight`` holds and blue elsewhere.
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, 3)
+    samples : dict of str to ndarray of int
+        Panel title to the indices of the sampled points.
+    highlight : ndarray of bool, shape (N,)
+    zlim : (float, float)
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(12, 4.5))
+    for i, (title, sample) in enumerate(samples.items()):
+        ax = new_3d_axes(fig, 1, len(samples), i + 1, title=title, elev=35)
+        plot_cloud(ax, points[::background_step], color="0.85", size=0.5)
+        ax.scatter(*points[sample].T, c=np.where(highlight[sample], "tab:red", "tab:blue"), s=12,
+                   depthshade=False)  # fmt: skip
+        ax.set_zlim(*zlim)
+    _show()
+
+
+def sampler_gallery(samples, scan_extent=((-80, 80), (-30, 30)), height_range=(-2, 6)):
+    """An object (3-D, top row) and a scan (from above, bottom row) reduced by each sampler.
+
+    Parameters
+    ----------
+    samples : dict of str to (ndarray of shape (M, 3), ndarray of shape (L, 3))
+        Sampler name to the sampled object and the sampled scan (metres).
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(15, 8))
+    columns = len(samples)
+    for i, (name, (object_sample, scan_sample)) in enumerate(samples.items()):
+        ax = new_3d_axes(fig, 2, columns, i + 1, title=f"{name}: {len(object_sample)} points")
+        plot_cloud(ax, object_sample, size=4, axis_labels=False)
+        ax = fig.add_subplot(2, columns, i + columns + 1)
+        ax.scatter(*scan_sample[:, :2].T, s=0.5, c=scan_sample[:, 2], cmap="viridis", vmin=height_range[0],
+                   vmax=height_range[1])  # fmt: skip
+        ax.set(xlim=scan_extent[0], ylim=scan_extent[1], aspect="equal", title=f"{len(scan_sample)} points",
+               xlabel="x (m)")  # fmt: skip
+    _show()
+
+
+def accuracy_against_samples(published, measured_sizes, measured, chance, published_title, measured_title):
+    """The paper's accuracies (left) beside the measured ones (right), against points per cloud.
+
+    Parameters
+    ----------
+    published : dict of str to (array_like, array_like)
+        Legend label to (points per cloud, accuracy in %).
+    measured_sizes : array_like of shape (M,)
+    measured : dict of str to array_like of shape (M,)
+        Sampler to accuracy (%).
+    chance : float
+        Accuracy of guessing (%), drawn dashed.
+    """
+    fig, (paper, ours) = _subplots(1, 2, (13, 4.2), sharey=True, layout="constrained")
+    for label, (sizes, values) in published.items():
+        paper.semilogx(sizes, values, marker="o", label=label)
+    paper.set(title=published_title, xlabel="points per test cloud", ylabel="accuracy (%)")
+    for name, values in measured.items():
+        ours.semilogx(measured_sizes, values, marker="o", label=name)
+    ours.axhline(chance, color="0.5", ls="--", label="chance")
+    ours.set(title=measured_title, xlabel="points per test cloud")
+    for ax in (paper, ours):
+        ax.invert_xaxis()
+        ax.grid(alpha=0.3, which="both")
+        ax.legend()
+    _show()
+
+
+def outlier_filters(points, mean_distances, threshold, k, kept, slab, extent=6.0):
+    """The mean-distance histogram with a threshold, and the points each filter removes.
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, 3)
+    mean_distances : ndarray of shape (N,)
+        Mean distance of each point to its ``k`` nearest neighbours.
+    threshold : float
+        The statistical filter's cut, drawn on the histogram.
+    kept : dict of str to ndarray of bool, shape (N,)
+        Panel title to each filter's kept mask.
+    slab : ndarray of bool, shape (N,)
+        The points shown (a slice of the 3-D cloud), from above.
+    """
+    fig, axes = _subplots(1, 1 + len(kept), (15, 4.4), layout="constrained")
+    axes[0].hist(mean_distances, bins=60, color="0.5")
+    axes[0].axvline(threshold, color="tab:red", label="mu + 3 sigma")
+    axes[0].set(xlabel=f"mean distance d_i to the {k} nearest", ylabel="points", yscale="log")
+    axes[0].legend()
+    for ax, (title, keep) in zip(axes[1:], kept.items()):
+        ax.scatter(*points[slab & keep, :2].T, s=3, color="0.6", label="kept")
+        ax.scatter(*points[slab & ~keep, :2].T, s=10, color="tab:red", label="removed")
+        ax.set(aspect="equal", title=title, xlim=(-extent, extent), ylim=(-extent, extent))
+        ax.legend(loc="upper right")
+    _show()
+
+
+def filtered_images(images, clean, row, columns):
+    """Images (top) and one row of each against the clean image's row (bottom).
+
+    Parameters
+    ----------
+    images : dict of str to ndarray of shape (H, W)
+    clean : ndarray of shape (H, W)
+    row : int
+        The row drawn below, marked in red above.
+    columns : (int, int)
+        The range of columns drawn below.
+    """
+    fig, axes = _subplots(2, len(images), (16, 6), gridspec_kw={"height_ratios": [3, 2]})
+    for ax, (label, image) in zip(axes[0], images.items()):
+        ax.imshow(image, cmap="gray", vmin=0, vmax=1.2)
+        ax.set_title(label, fontsize=9)
+        ax.axhline(row, color="tab:red", lw=0.8)
+        ax.set_axis_off()
+    for ax, image in zip(axes[1], images.values()):
+        ax.plot(clean[row], color="0.6", lw=3, label="clean")
+        ax.plot(image[row], color="tab:red", lw=1)
+        ax.set(xlim=columns, ylim=(0, 1.1), xlabel="column")
+    axes[1, 0].legend()
+    _show()
+
+
+def box_slices(clouds, slab, outline):
+    """A slice of each cloud in the xz plane, over the true box's outline (grey).
+
+    Parameters
+    ----------
+    clouds : dict of str to ndarray of shape (N, 3)
+    slab : ndarray of bool, shape (N,)
+        The points shown.
+    outline : (float, float)
+        The box's size along x and z, centred on the origin.
+    """
+    import matplotlib.pyplot as plt
+
+    width, height = outline
+    fig, axes = _subplots(1, len(clouds), (14, 3.8), sharey=True)
+    for ax, (label, points) in zip(axes, clouds.items()):
+        ax.add_patch(plt.Rectangle((-width / 2, -height / 2), width, height, fill=False, color="0.6", lw=2))
+        ax.scatter(points[slab, 0], points[slab, 2], s=2, c="tab:blue")
+        ax.set(title=label, aspect="equal", xlim=(-0.6 * width, 0.6 * width), ylim=(-0.7 * height, 0.7 * height),
+               xlabel="x")  # fmt: skip
+    axes[0].set_ylabel("z")
+    _show()
