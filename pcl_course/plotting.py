@@ -498,7 +498,7 @@ def lifting_figure(points, labels, first_linear, lifted, lifted_coordinates, com
     """
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(13, 4.2))
+    fig = plt.figure(figsize=(14, 4.2))
     ax = fig.add_subplot(1, 3, 1)
     ax.scatter(*points.T, c=labels, cmap="coolwarm", s=8)
     ax.scatter(first_linear, np.full(len(points), -1.4), c=labels, cmap="coolwarm", s=4, marker="|")
@@ -508,7 +508,7 @@ def lifting_figure(points, labels, first_linear, lifted, lifted_coordinates, com
     ax = fig.add_subplot(1, 3, 3)
     ax.scatter(lifted_coordinates[:, 0], lifted_coordinates[:, component], c=labels, cmap="coolwarm", s=8)
     ax.set(xlabel="1st lifted principal coordinate", ylabel=f"principal coordinate {component + 1}")
-    fig.subplots_adjust(wspace=0.35)
+    fig.subplots_adjust(wspace=0.5)  # room for the 3-D axes' tick labels, which overhang their box
     _show()
 
 
@@ -569,6 +569,8 @@ def error_against_radius(radii, errors, shapes, noises):
         for noise in noises:
             ax.plot(radii, errors[shape, noise], marker="o", label=f"noise {noise}")
         ax.set(title=shape, xlabel="radius", xscale="log", yscale="log")
+        ax.set_xticks(radii, [f"{r:g}" for r in radii])  # the radii measured, not powers of ten
+        ax.set_xticks([], minor=True)
         ax.grid(alpha=0.3, which="both")
     axes[0].set_ylabel("mean angular error (degrees)")
     axes[-1].legend()
