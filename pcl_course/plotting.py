@@ -527,6 +527,13 @@ def component_scatter(panels, labels):
     _show()
 
 
+def _ticks_at(ax, x, most=10):
+    """Label a log x axis at the values measured (at most ``most``), not at powers of ten."""
+    if len(x) <= most:
+        ax.set_xticks(x, [f"{int(value):,}" if float(value).is_integer() else f"{value:g}" for value in x])
+        ax.set_xticks([], minor=True)
+
+
 def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vline=None, floor=None,
            figsize=(7, 4)):  # fmt: skip
     """Several curves over one x axis, with a legend.
@@ -548,6 +555,8 @@ def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vli
     if vline is not None:
         ax.axvline(vline[0], ls=":", c="gray", label=vline[1])
     ax.set(xlabel=xlabel, ylabel=ylabel, xscale=xscale, yscale=yscale)
+    if xscale == "log":
+        _ticks_at(ax, x)
     if ylim is not None:
         ax.set_ylim(*ylim)
     ax.legend()
@@ -569,8 +578,7 @@ def error_against_radius(radii, errors, shapes, noises):
         for noise in noises:
             ax.plot(radii, errors[shape, noise], marker="o", label=f"noise {noise}")
         ax.set(title=shape, xlabel="radius", xscale="log", yscale="log")
-        ax.set_xticks(radii, [f"{r:g}" for r in radii])  # the radii measured, not powers of ten
-        ax.set_xticks([], minor=True)
+        _ticks_at(ax, radii)
         ax.grid(alpha=0.3, which="both")
     axes[0].set_ylabel("mean angular error (degrees)")
     axes[-1].legend()
@@ -646,12 +654,12 @@ def sampler_gallery(samples, scan_extent=((-80, 80), (-30, 30)), height_range=(-
     """
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(15, 8))
-    columns = len(samples)
+    fig = plt.figure(figsize=(15, 6.5))
+    grid = fig.add_gridspec(2, len(samples), height_ratios=(2.2, 1))  # the scan's panels are flat
     for i, (name, (object_sample, scan_sample)) in enumerate(samples.items()):
-        ax = new_3d_axes(fig, 2, columns, i + 1, title=f"{name}: {len(object_sample)} points")
+        ax = new_3d_axes(fig, grid[0, i], title=f"{name}: {len(object_sample)} points")
         plot_cloud(ax, object_sample, size=4, axis_labels=False)
-        ax = fig.add_subplot(2, columns, i + columns + 1)
+        ax = fig.add_subplot(grid[1, i])
         ax.scatter(*scan_sample[:, :2].T, s=0.5, c=scan_sample[:, 2], cmap="viridis", vmin=height_range[0],
                    vmax=height_range[1])  # fmt: skip
         ax.set(xlim=scan_extent[0], ylim=scan_extent[1], aspect="equal", title=f"{len(scan_sample)} points",

@@ -10,7 +10,7 @@ key.
 """
 
 from docutils import nodes
-from myst_nb.ext.glue.domain import GlueDomain
+from myst_nb.ext.glue.domain import NbGlueDomain
 from myst_nb.ext.glue.roles import PasteTextRole
 
 MARKER = "[not computed: a cell above failed]"
@@ -29,5 +29,5 @@ class PasteTextOrMarker(PasteTextRole):
 
 
 def setup(app):
-    GlueDomain.roles["text"] = PasteTextOrMarker()
+    NbGlueDomain.roles["text"] = PasteTextOrMarker()
     return {"parallel_read_safe": True, "parallel_write_safe": True}
