@@ -7,6 +7,7 @@ student's own ``pcl_course`` code.
 """
 
 import importlib
+from pathlib import Path
 
 __all__ = ["implementation"]
 
@@ -29,17 +30,49 @@ def implementation(module):
 
 
 def _show_stubs_briefly():
-    """In a notebook, show a stub's NotImplementedError as one line, not a traceback."""
+    """In a notebook, show a stub's NotImplementedError as one line, not a traceback.
+
+    Once a stub has failed, the later cells that use its results fail too (a
+    name never assigned, an empty table); those show as one line as well. An
+    error raised inside the student's own exercise code still shows its whole
+    traceback: that one is a bug to find, not a consequence.
+    """
     try:
         shell = get_ipython()  # noqa: F821 -- defined inside IPython only
     except NameError:
         return
+    stub_failed = False
 
-    def not_implemented(shell, etype, value, tb, tb_offset=None):
-        print(
-            f"Not implemented yet: {value}. Implement it in pcl_course/, then rebuild the book "
-            "to see this cell's results."
-        )
-        return []
+    def brief_or_full(shell, etype, value, tb, tb_offset=None):
+        nonlocal stub_failed
+        if issubclass(etype, NotImplementedError):
+            stub_failed = True
+            print(
+                f"Not implemented yet: {value}. Implement it in pcl_course/, then rebuild the book "
+                "to see this cell's results."
+            )
+            return []
+        if stub_failed and not _raised_in_exercise_code(tb):
+            print(f"Not run: this cell needs results that a function not implemented yet did not give "
+                  f"({etype.__name__}: {value}).")  # fmt: skip
+            return []
+        return shell.InteractiveTB.structured_traceback(etype, value, tb, tb_offset=tb_offset)
 
-    shell.set_custom_exc((NotImplementedError,), not_implemented)
+    shell.set_custom_exc((Exception,), brief_or_full)
+
+
+def _raised_in_exercise_code(tb):
+    """Whether a traceback passes through an exercise module of ``pcl_course`` (the student's code)."""
+    package = Path(__file__).resolve().parent
+    while tb is not None:
+        path = Path(tb.tb_frame.f_code.co_filename)
+        if path.parent == package and path.stem not in _NOT_EXERCISES:
+            return True
+        tb = tb.tb_next
+    return False
+
+
+# The modules of pcl_course that are complete helpers, not exercises: the
+# grader's HELPER_MODULES (a project test keeps the two equal; the student
+# package cannot import the grader).
+_NOT_EXERCISES = frozenset({"__init__", "book", "plotting", "validation", "neighbors", "datasets", "io"})

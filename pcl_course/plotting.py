@@ -520,8 +520,8 @@ def component_scatter(panels, labels):
     panels : dict of str to ndarray of shape (N, >= 2)
     labels : ndarray of shape (N,)
     """
-    fig, axes = _subplots(1, len(panels), (15, 3.8), layout="constrained")
-    for ax, (title, projections) in zip(np.atleast_1d(axes), panels.items()):
+    fig, axes = _subplots(1, len(panels), (15, 3.8), layout="constrained", squeeze=False)
+    for ax, (title, projections) in zip(axes[0], panels.items()):
         ax.scatter(*projections[:, :2].T, c=labels, cmap="coolwarm", s=8)
         ax.set(title=title, xlabel="1st component", ylabel="2nd component")
     _show()
@@ -573,7 +573,8 @@ def error_against_radius(radii, errors, shapes, noises):
     errors : dict of (str, float) to array_like of shape (M,)
         ``errors[shape, noise]``, degrees.
     """
-    fig, axes = _subplots(1, len(shapes), (12, 4), sharey=True)
+    fig, axes = _subplots(1, len(shapes), (12, 4), sharey=True, squeeze=False)
+    axes = axes[0]
     for ax, shape in zip(axes, shapes):
         for noise in noises:
             ax.plot(radii, errors[shape, noise], marker="o", label=f"noise {noise}")
@@ -593,7 +594,8 @@ def precision_recall_panels(panels):
     panels : list of (str, array_like of shape (M,), list of (float, float))
         The parameter's label, its values and (precision, recall) at each.
     """
-    fig, axes = _subplots(1, len(panels), (12, 3.8), sharey=True)
+    fig, axes = _subplots(1, len(panels), (12, 3.8), sharey=True, squeeze=False)
+    axes = axes[0]
     for ax, (label, xs, pr) in zip(axes, panels):
         ax.plot(xs, [p for p, _ in pr], marker="o", label="precision")
         ax.plot(xs, [r for _, r in pr], marker="s", label="recall")
@@ -613,7 +615,8 @@ def samples_top_view(points, samples, background_step=10):
     samples : dict of str to ndarray of shape (M, >= 2)
         Panel title to the sampled points.
     """
-    fig, axes = _subplots(1, len(samples), (12, 4.5), layout="constrained")
+    fig, axes = _subplots(1, len(samples), (12, 4.5), layout="constrained", squeeze=False)
+    axes = axes[0]
     for ax, (title, sample) in zip(axes, samples.items()):
         ax.scatter(*points[::background_step, :2].T, s=1, color="0.85")
         ax.scatter(*sample[:, :2].T, s=10, color="tab:blue")
@@ -710,7 +713,8 @@ def outlier_filters(points, mean_distances, threshold, k, kept, slab, extent=6.0
     slab : ndarray of bool, shape (N,)
         The points shown (a slice of the 3-D cloud), from above.
     """
-    fig, axes = _subplots(1, 1 + len(kept), (15, 4.4), layout="constrained")
+    fig, axes = _subplots(1, 1 + len(kept), (15, 4.4), layout="constrained", squeeze=False)
+    axes = axes[0]
     axes[0].hist(mean_distances, bins=60, color="0.5")
     axes[0].axvline(threshold, color="tab:red", label="mu + 3 sigma")
     axes[0].set(xlabel=f"mean distance d_i to the {k} nearest", ylabel="points", yscale="log")
@@ -735,7 +739,7 @@ def filtered_images(images, clean, row, columns):
     columns : (int, int)
         The range of columns drawn below.
     """
-    fig, axes = _subplots(2, len(images), (16, 6), gridspec_kw={"height_ratios": [3, 2]})
+    fig, axes = _subplots(2, len(images), (16, 6), gridspec_kw={"height_ratios": [3, 2]}, squeeze=False)
     for ax, (label, image) in zip(axes[0], images.items()):
         ax.imshow(image, cmap="gray", vmin=0, vmax=1.2)
         ax.set_title(label, fontsize=9)
@@ -763,7 +767,8 @@ def box_slices(clouds, slab, outline):
     import matplotlib.pyplot as plt
 
     width, height = outline
-    fig, axes = _subplots(1, len(clouds), (14, 3.8), sharey=True)
+    fig, axes = _subplots(1, len(clouds), (14, 3.8), sharey=True, squeeze=False)
+    axes = axes[0]
     for ax, (label, points) in zip(axes, clouds.items()):
         ax.add_patch(plt.Rectangle((-width / 2, -height / 2), width, height, fill=False, color="0.6", lw=2))
         ax.scatter(points[slab, 0], points[slab, 2], s=2, c="tab:blue")

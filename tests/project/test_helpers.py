@@ -112,3 +112,20 @@ def test_check_same_shape_names_the_argument_and_the_shape():
         check_same_shape(a, "a", (5, 3), "the shape of b")
     with pytest.raises(ValueError, match="^g must have"):
         check_same_shape(np.zeros(4), "g", (4, 3), "the height and width of d", leading=True)
+
+
+def test_the_book_tells_the_students_code_from_helpers_by_the_grader_s_list():
+    from grading.config import HELPER_MODULES
+
+    assert book._NOT_EXERCISES == set(HELPER_MODULES)
+
+
+def test_the_book_shows_a_bug_in_exercise_code_in_full_and_a_consequence_briefly():
+    from pcl_course import pca, plotting
+
+    with pytest.raises(NotImplementedError) as in_a_stub:
+        pca.pca(np.zeros((4, 3)))
+    assert book._raised_in_exercise_code(in_a_stub.tb)  # the student's module: a full traceback
+    with pytest.raises(ValueError) as in_a_helper:
+        plotting.samples_top_view(np.zeros((4, 3)), {})  # no samples: what a failed stub leaves behind
+    assert not book._raised_in_exercise_code(in_a_helper.tb)

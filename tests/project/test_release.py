@@ -164,6 +164,10 @@ def test_the_release_book_builds_with_the_stubs(release_dir):
     # A sentence whose number the stub could not compute says so, instead of losing the number.
     kernel_page = (release_dir / "_build" / "html" / "book" / "kernel_pca.html").read_text()
     assert "[not computed: a cell above failed]" in kernel_page
+    # The cells that use a stub's results show one line each, not a traceback.
+    assert "Not run: this cell needs results" in kernel_page
+    for built in (release_dir / "_build" / "html" / "book").glob("*.html"):
+        assert "Traceback" not in built.read_text(), built.name
     assert "lambda_k = s_k^2 / N: True" not in page  # no reference results
     assert find_leaks(release_dir / "_build" / "html") == []
 
