@@ -739,7 +739,8 @@ def filtered_images(images, clean, row, columns):
     columns : (int, int)
         The range of columns drawn below.
     """
-    fig, axes = _subplots(2, len(images), (16, 6), gridspec_kw={"height_ratios": [3, 2]}, squeeze=False)
+    fig, axes = _subplots(2, len(images), (16, 5.2), gridspec_kw={"height_ratios": [3, 2]}, squeeze=False,
+                          layout="constrained")  # fmt: skip
     for ax, (label, image) in zip(axes[0], images.items()):
         ax.imshow(image, cmap="gray", vmin=0, vmax=1.2)
         ax.set_title(label, fontsize=9)
