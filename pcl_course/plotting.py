@@ -247,18 +247,6 @@ def worst_difference_window(error_a, error_b, valid, size):
 # one line that draws it. Each draws a matplotlib figure and shows it.
 
 
-def _subplots(rows, columns, figsize, **kwargs):
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(rows, columns, figsize=figsize, **kwargs)
-
-
-def _show():
-    import matplotlib.pyplot as plt
-
-    plt.show()
-
-
 def cloud_gallery(panels, columns, figsize, size=1.0, axis_labels=False, axis_off=True):
     """3-D views of several clouds in a grid, filled row by row.
 
@@ -282,7 +270,7 @@ def cloud_gallery(panels, columns, figsize, size=1.0, axis_labels=False, axis_of
         plot_cloud(ax, points, size=marker_size, axis_labels=axis_labels)
         if axis_off:
             ax.set_axis_off()
-    _show()
+    plt.show()
 
 
 def principal_axes_gallery(panels, columns, figsize, color="0.6", size=0.5, width=2.5, axis_off=False):
@@ -305,7 +293,7 @@ def principal_axes_gallery(panels, columns, figsize, color="0.6", size=0.5, widt
                          lw=width)  # fmt: skip
         if axis_off:
             ax.set_axis_off()
-    _show()
+    plt.show()
 
 
 def angular_error_gallery(panels, figsize, size=3.0, arrows=None, axis_off=False, clip=30.0):
@@ -333,7 +321,7 @@ def angular_error_gallery(panels, figsize, size=3.0, arrows=None, axis_off=False
         if axis_off:
             ax.set_axis_off()
     fig.colorbar(artist, ax=fig.axes, shrink=0.7, label=f"angular error (degrees, clipped at {clip:g})")
-    _show()
+    plt.show()
 
 
 def scan_top_view(points, labels, is_outlier, class_names, colors=("0.6", "tab:blue", "tab:orange", "k",
@@ -348,8 +336,10 @@ def scan_top_view(points, labels, is_outlier, class_names, colors=("0.6", "tab:b
         Indices into ``class_names``.
     is_outlier : ndarray of bool, shape (N,)
     """
+    import matplotlib.pyplot as plt
+
     colors = np.asarray(colors)
-    fig, ax = _subplots(1, 1, (8, 8))
+    fig, ax = plt.subplots(1, 1, figsize=(8, 8))
     inliers = ~is_outlier
     ax.scatter(*points[inliers, :2].T, s=0.2, c=colors[labels[inliers]], linewidths=0)
     ax.scatter(*points[is_outlier, :2].T, s=3, c="red", linewidths=0, label="spurious returns")
@@ -357,7 +347,7 @@ def scan_top_view(points, labels, is_outlier, class_names, colors=("0.6", "tab:b
         ax.scatter([], [], c=color, s=20, label=label)
     ax.set(xlim=(-60, 60), ylim=(-60, 60), aspect="equal", xlabel="x (m)", ylabel="y (m)")
     ax.legend(loc="upper right", markerscale=1)
-    _show()
+    plt.show()
 
 
 def _angle_degrees(vector):
@@ -377,14 +367,16 @@ def rayleigh_curve(angles, quotient, eigenvalues, eigenvectors):
     eigenvectors : ndarray of shape (2, 2)
         Columns.
     """
-    fig, ax = _subplots(1, 1, (7, 3.5))
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 1, figsize=(7, 3.5))
     ax.plot(np.degrees(angles), quotient, label=r"$R_A(\cos\theta, \sin\theta)$")
     for value, vector in zip(eigenvalues, eigenvectors.T):
         ax.axhline(value, ls="--", c="gray")
         ax.axvline(_angle_degrees(vector), ls=":", c="gray")
     ax.set(xlabel=r"$\theta$ (degrees)", ylabel="Rayleigh quotient")
     ax.legend()
-    _show()
+    plt.show()
 
 
 def rotating_direction(cloud, angles, variance, eigenvectors, shown_degrees=(0, 30, 60, 90, 120, 150)):
@@ -400,7 +392,9 @@ def rotating_direction(cloud, angles, variance, eigenvectors, shown_degrees=(0, 
     eigenvectors : ndarray of shape (2, 2)
         The covariance's eigenvectors (columns), marked as dashed lines.
     """
-    fig, (left, right) = _subplots(1, 2, (11, 4), layout="constrained")
+    import matplotlib.pyplot as plt
+
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4), layout="constrained")
     left.scatter(*cloud.T, s=5, color="0.6")
     for a in np.deg2rad(shown_degrees):
         left.plot([0, 2.5 * np.cos(a)], [0, 2.5 * np.sin(a)], lw=1)
@@ -409,7 +403,7 @@ def rotating_direction(cloud, angles, variance, eigenvectors, shown_degrees=(0, 
     for vector in eigenvectors.T:
         right.axvline(_angle_degrees(vector), ls="--", color="k")
     right.set(xlabel="angle theta of z (degrees)", ylabel="variance of the coordinates z.x~")
-    _show()
+    plt.show()
 
 
 def eigen_images(mean, eigenvectors, share, image_shape, count=9):
@@ -424,7 +418,9 @@ def eigen_images(mean, eigenvectors, share, image_shape, count=9):
         Share of the variance along each direction, shown in its title.
     image_shape : (int, int)
     """
-    fig, axes = _subplots(1, count + 1, (13, 1.8))
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, count + 1, figsize=(13, 1.8))
     axes[0].imshow(mean.reshape(image_shape), cmap="gray_r")
     axes[0].set_title("mean")
     for k, ax in enumerate(axes[1:]):
@@ -433,7 +429,7 @@ def eigen_images(mean, eigenvectors, share, image_shape, count=9):
         ax.set_title(f"u{k + 1}: {share[k]:.1%}")
     for ax in axes:
         ax.set_axis_off()
-    _show()
+    plt.show()
 
 
 def reconstruction_figure(kept_share, rows, image_shape, vmax):
@@ -466,19 +462,21 @@ def reconstruction_figure(kept_share, rows, image_shape, vmax):
             a.set_yticks([])
             if column == 0:
                 a.set_ylabel(label, rotation=0, labelpad=18)
-    _show()
+    plt.show()
 
 
 def labelled_codes(codes, labels):
     """Points at their first two coordinates, coloured by class, each class's label at its mean."""
-    fig, ax = _subplots(1, 1, (7, 6))
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 1, figsize=(7, 6))
     scatter = ax.scatter(codes[:, 0], codes[:, 1], c=labels, cmap="tab10", s=8)
     for label in np.unique(labels):
         ax.annotate(str(label), codes[labels == label].mean(axis=0), fontsize=16, weight="bold", ha="center",
                     va="center", bbox=dict(boxstyle="circle", fc="white", alpha=0.8))  # fmt: skip
     ax.set(xlabel="first principal coordinate", ylabel="second principal coordinate")
     fig.colorbar(scatter, ax=ax, ticks=np.unique(labels), label="digit")
-    _show()
+    plt.show()
 
 
 def lifting_figure(points, labels, first_linear, lifted, lifted_coordinates, component):
@@ -509,7 +507,7 @@ def lifting_figure(points, labels, first_linear, lifted, lifted_coordinates, com
     ax.scatter(lifted_coordinates[:, 0], lifted_coordinates[:, component], c=labels, cmap="coolwarm", s=8)
     ax.set(xlabel="1st lifted principal coordinate", ylabel=f"principal coordinate {component + 1}")
     fig.subplots_adjust(wspace=0.5)  # room for the 3-D axes' tick labels, which overhang their box
-    _show()
+    plt.show()
 
 
 def component_scatter(panels, labels):
@@ -520,11 +518,13 @@ def component_scatter(panels, labels):
     panels : dict of str to ndarray of shape (N, >= 2)
     labels : ndarray of shape (N,)
     """
-    fig, axes = _subplots(1, len(panels), (15, 3.8), layout="constrained", squeeze=False)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(panels), figsize=(15, 3.8), layout="constrained", squeeze=False)
     for ax, (title, projections) in zip(axes[0], panels.items()):
         ax.scatter(*projections[:, :2].T, c=labels, cmap="coolwarm", s=8)
         ax.set(title=title, xlabel="1st component", ylabel="2nd component")
-    _show()
+    plt.show()
 
 
 def _ticks_at(ax, x, most=10):
@@ -548,7 +548,9 @@ def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vli
     floor : float, optional
         Values below it are drawn at it (a log scale has no 0).
     """
-    fig, ax = _subplots(1, 1, figsize)
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 1, figsize=figsize)
     for label, ys in values.items():
         ys = np.asarray(ys, dtype=float)
         ax.plot(x, ys if floor is None else np.maximum(ys, floor), marker="o", label=label)
@@ -561,7 +563,7 @@ def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vli
         ax.set_ylim(*ylim)
     ax.legend()
     ax.grid(alpha=0.3, which="both")
-    _show()
+    plt.show()
 
 
 def error_against_radius(radii, errors, shapes, noises):
@@ -573,7 +575,9 @@ def error_against_radius(radii, errors, shapes, noises):
     errors : dict of (str, float) to array_like of shape (M,)
         ``errors[shape, noise]``, degrees.
     """
-    fig, axes = _subplots(1, len(shapes), (12, 4), sharey=True, squeeze=False)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(shapes), figsize=(12, 4), sharey=True, squeeze=False)
     axes = axes[0]
     for ax, shape in zip(axes, shapes):
         for noise in noises:
@@ -583,7 +587,7 @@ def error_against_radius(radii, errors, shapes, noises):
         ax.grid(alpha=0.3, which="both")
     axes[0].set_ylabel("mean angular error (degrees)")
     axes[-1].legend()
-    _show()
+    plt.show()
 
 
 def precision_recall_panels(panels):
@@ -594,7 +598,9 @@ def precision_recall_panels(panels):
     panels : list of (str, array_like of shape (M,), list of (float, float))
         The parameter's label, its values and (precision, recall) at each.
     """
-    fig, axes = _subplots(1, len(panels), (12, 3.8), sharey=True, squeeze=False)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(panels), figsize=(12, 3.8), sharey=True, squeeze=False)
     axes = axes[0]
     for ax, (label, xs, pr) in zip(axes, panels):
         ax.plot(xs, [p for p, _ in pr], marker="o", label="precision")
@@ -603,7 +609,7 @@ def precision_recall_panels(panels):
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("share")
     axes[0].legend()
-    _show()
+    plt.show()
 
 
 def samples_top_view(points, samples, background_step=10):
@@ -615,13 +621,15 @@ def samples_top_view(points, samples, background_step=10):
     samples : dict of str to ndarray of shape (M, >= 2)
         Panel title to the sampled points.
     """
-    fig, axes = _subplots(1, len(samples), (12, 4.5), layout="constrained", squeeze=False)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(samples), figsize=(12, 4.5), layout="constrained", squeeze=False)
     axes = axes[0]
     for ax, (title, sample) in zip(axes, samples.items()):
         ax.scatter(*points[::background_step, :2].T, s=1, color="0.85")
         ax.scatter(*sample[:, :2].T, s=10, color="tab:blue")
         ax.set(aspect="equal", title=title, xticks=[], yticks=[])
-    _show()
+    plt.show()
 
 
 def highlighted_samples(points, samples, highlight, zlim, background_step=10):
@@ -644,7 +652,7 @@ def highlighted_samples(points, samples, highlight, zlim, background_step=10):
         ax.scatter(*points[sample].T, c=np.where(highlight[sample], "tab:red", "tab:blue"), s=12,
                    depthshade=False)  # fmt: skip
         ax.set_zlim(*zlim)
-    _show()
+    plt.show()
 
 
 def sampler_gallery(samples, scan_extent=((-80, 80), (-30, 30)), height_range=(-2, 6)):
@@ -667,7 +675,7 @@ def sampler_gallery(samples, scan_extent=((-80, 80), (-30, 30)), height_range=(-
                    vmax=height_range[1])  # fmt: skip
         ax.set(xlim=scan_extent[0], ylim=scan_extent[1], aspect="equal", title=f"{len(scan_sample)} points",
                xlabel="x (m)")  # fmt: skip
-    _show()
+    plt.show()
 
 
 def accuracy_against_samples(published, measured_sizes, measured, chance, published_title, measured_title):
@@ -683,7 +691,9 @@ def accuracy_against_samples(published, measured_sizes, measured, chance, publis
     chance : float
         Accuracy of guessing (%), drawn dashed.
     """
-    fig, (paper, ours) = _subplots(1, 2, (13, 4.2), sharey=True, layout="constrained")
+    import matplotlib.pyplot as plt
+
+    fig, (paper, ours) = plt.subplots(1, 2, figsize=(13, 4.2), sharey=True, layout="constrained")
     for label, (sizes, values) in published.items():
         paper.semilogx(sizes, values, marker="o", label=label)
     paper.set(title=published_title, xlabel="points per test cloud", ylabel="accuracy (%)")
@@ -695,7 +705,7 @@ def accuracy_against_samples(published, measured_sizes, measured, chance, publis
         ax.invert_xaxis()
         ax.grid(alpha=0.3, which="both")
         ax.legend()
-    _show()
+    plt.show()
 
 
 def outlier_filters(points, mean_distances, threshold, k, kept, slab, extent=6.0):
@@ -713,7 +723,9 @@ def outlier_filters(points, mean_distances, threshold, k, kept, slab, extent=6.0
     slab : ndarray of bool, shape (N,)
         The points shown (a slice of the 3-D cloud), from above.
     """
-    fig, axes = _subplots(1, 1 + len(kept), (15, 4.4), layout="constrained", squeeze=False)
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 1 + len(kept), figsize=(15, 4.4), layout="constrained", squeeze=False)
     axes = axes[0]
     axes[0].hist(mean_distances, bins=60, color="0.5")
     axes[0].axvline(threshold, color="tab:red", label="mu + 3 sigma")
@@ -724,7 +736,7 @@ def outlier_filters(points, mean_distances, threshold, k, kept, slab, extent=6.0
         ax.scatter(*points[slab & ~keep, :2].T, s=10, color="tab:red", label="removed")
         ax.set(aspect="equal", title=title, xlim=(-extent, extent), ylim=(-extent, extent))
         ax.legend(loc="upper right")
-    _show()
+    plt.show()
 
 
 def filtered_images(images, clean, row, columns):
@@ -739,7 +751,9 @@ def filtered_images(images, clean, row, columns):
     columns : (int, int)
         The range of columns drawn below.
     """
-    fig, axes = _subplots(2, len(images), (16, 5.2), gridspec_kw={"height_ratios": [3, 2]}, squeeze=False,
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, len(images), figsize=(16, 5.2), gridspec_kw={"height_ratios": [3, 2]}, squeeze=False,
                           layout="constrained")  # fmt: skip
     for ax, (label, image) in zip(axes[0], images.items()):
         ax.imshow(image, cmap="gray", vmin=0, vmax=1.2)
@@ -751,7 +765,7 @@ def filtered_images(images, clean, row, columns):
         ax.plot(image[row], color="tab:red", lw=1)
         ax.set(xlim=columns, ylim=(0, 1.1), xlabel="column")
     axes[1, 0].legend()
-    _show()
+    plt.show()
 
 
 def box_slices(clouds, slab, outline):
@@ -768,7 +782,7 @@ def box_slices(clouds, slab, outline):
     import matplotlib.pyplot as plt
 
     width, height = outline
-    fig, axes = _subplots(1, len(clouds), (14, 3.8), sharey=True, squeeze=False)
+    fig, axes = plt.subplots(1, len(clouds), figsize=(14, 3.8), sharey=True, squeeze=False)
     axes = axes[0]
     for ax, (label, points) in zip(axes, clouds.items()):
         ax.add_patch(plt.Rectangle((-width / 2, -height / 2), width, height, fill=False, color="0.6", lw=2))
@@ -776,4 +790,4 @@ def box_slices(clouds, slab, outline):
         ax.set(title=label, aspect="equal", xlim=(-0.6 * width, 0.6 * width), ylim=(-0.7 * height, 0.7 * height),
                xlabel="x")  # fmt: skip
     axes[0].set_ylabel("z")
-    _show()
+    plt.show()

@@ -10,7 +10,6 @@ key.
 """
 
 from docutils import nodes
-from myst_nb.ext.glue.domain import NbGlueDomain
 from myst_nb.ext.glue.roles import PasteTextRole
 
 MARKER = "[not computed: a cell above failed]"
@@ -29,5 +28,5 @@ class PasteTextOrMarker(PasteTextRole):
 
 
 def setup(app):
-    NbGlueDomain.roles["text"] = PasteTextOrMarker()
+    app.add_role_to_domain("glue", "text", PasteTextOrMarker(), override=True)
     return {"parallel_read_safe": True, "parallel_write_safe": True}

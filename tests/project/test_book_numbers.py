@@ -8,12 +8,12 @@ the text and the code change together, or this test fails). A number typed
 by hand from an output, such as a measured error, is neither, and fails.
 
 Mathematics (``$...$``, display blocks) is not checked: it holds derivations
-and worked examples by hand, whose code checks follow them. Integers are not
-checked (counts, years, sizes and powers of two are mostly definitions);
-version numbers of pinned packages and of Python are allowed, and so is a
-sentence that cites its source with ``{cite}``.
+and worked examples by hand, whose code checks follow them. Version numbers
+of pinned packages and of Python are allowed, and so is a sentence that cites
+its source with ``{cite}``.
 
-Integers of two or more digits are checked too. An exercise's points
+Integers of two or more digits are checked too; one-digit ones are not
+(mostly counts in an argument). An exercise's points
 (``**28 points** (17 and 11)``) are exempt here, because ``test_contract``
 checks them against the grader's. The few integers that define rather than
 measure, and that no cell on the page sets, are listed in ``DEFINED`` with
