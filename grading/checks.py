@@ -8,7 +8,7 @@ broke without any value: what a hidden test shows.
 
 import numpy as np
 
-from grading.errors import CheckFailed
+from grading.errors import CheckFailed, DidNotRaise
 
 _DTYPE_KINDS = {"float64": np.float64, "int64": np.int64, "bool": np.bool_}
 
@@ -126,3 +126,49 @@ def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
         )
         message = f"{name} must have orthonormal columns, but {what}"
         raise CheckFailed(_with_hint(message, hint), rule=f"{name} must have orthonormal columns")
+
+
+def check_unmodified(impl, function):
+    """Check that the last call of ``impl`` modified none of its arguments in place.
+
+    The grader's arguments are never changed by a call (each call works on
+    private copies): whether it modified them is recorded as the call's
+    verdict, :attr:`grading.implementation.Implementation.last_modified`.
+    """
+    if impl.last_modified:
+        names = ", ".join(impl.last_modified)
+        raise CheckFailed(
+            f"{function} modified its input in place ({names}): work on a copy "
+            "(np.array(points, dtype=float) copies; points -= ... does not)",
+            rule="an input was modified in place",
+        )
+
+
+class raises:
+    """``with raises(ValueError) as caught:`` -- the call inside must raise ``expected``.
+
+    Like ``pytest.raises``, but a call that returns normally fails with
+    :class:`grading.errors.DidNotRaise`: the grader knows that verdict by its
+    class, not by the words of pytest's message. Another exception passes
+    through (the submission's error, shown as such); ``caught.value`` is
+    the exception raised.
+    """
+
+    def __init__(self, expected):
+        self.expected = expected
+        self.value = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, value, traceback):
+        if kind is None:
+            names = self.expected.__name__ if isinstance(self.expected, type) else "an error"
+            raise DidNotRaise(
+                f"expected the call to raise {names}, but it returned normally",
+                rule=f"expected the call to raise {names}, but it returned normally",
+            )
+        if issubclass(kind, self.expected):
+            self.value = value
+            return True
+        return False

@@ -36,17 +36,14 @@ import csv
 import json
 import os
 import queue
-import subprocess
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from grading import GRADED_FUNCTIONS, GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT, config
-from grading.plugin import max_score, points_per_function
-
-PYTEST_EXIT_NO_TESTS = 5
-PYTEST_EXIT_USAGE = 4
+from grading import GRADED_FUNCTIONS, REPO_ROOT, config
+from grading.results import Grading
+from grading.runner import PYTEST_EXIT_NO_TESTS, PYTEST_EXIT_USAGE, run_graded_tests
 
 
 def find_package(submission):
@@ -60,100 +57,6 @@ def find_package(submission):
         if candidate.name == "pcl_course" and os.path.lexists(candidate):
             return candidate
     raise SystemExit(f"error: no pcl_course/ package found in {submission}")
-
-
-def run_graded_tests(
-    impl_dir,
-    results,
-    keyword=None,
-    junit=None,
-    overrides=(),
-    tests=None,
-    sandbox=False,
-    call_timeout=None,
-    require_isolation=False,
-    sandbox_uid=None,
-    functions=(),
-    budget=None,
-    note=None,
-    diagnose_always=False,
-):
-    """Run the graded tests on ``impl_dir``; return pytest's exit code and its output."""
-    if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
-        tests = [d for d in (GRADED_TESTS, HIDDEN_TESTS) if d.is_dir()]
-    command = [
-        sys.executable,
-        "-m",
-        "pytest",
-        *[str(t) for t in (tests if isinstance(tests, list) else [tests])],
-        # The grader's own configuration only: nothing from the submission.
-        "-c",
-        str(REPO_ROOT / "grading" / "pytest.ini"),
-        "--rootdir",
-        str(REPO_ROOT),
-        "-p",
-        "pytest_timeout",
-        "-p",
-        "grading.plugin",
-        "-p",
-        "no:cacheprovider",
-        "--impl",
-        str(impl_dir),
-        "--results",
-        str(results),
-        "-q",
-        "--tb=no",
-        "--no-header",
-        "-rN",
-    ]
-    for override in overrides:
-        command += ["--impl-module", override]
-    if sandbox:
-        command.append("--sandbox")
-    if require_isolation:
-        command.append("--require-isolation")
-    if sandbox_uid is not None:
-        command += ["--sandbox-uid", str(sandbox_uid)]
-    if call_timeout:
-        command += ["--call-timeout", str(call_timeout)]
-    if keyword:
-        command += ["-k", keyword]
-    for function in functions:
-        command += ["--function", function]
-    if budget is not None:
-        command += ["--budget", str(budget)]
-    if note:
-        command += ["--submission-note", note]
-    if diagnose_always:
-        command.append("--diagnose-always")
-    if junit:
-        command += ["--junitxml", str(junit)]
-    # Only the plugins named above: the environment's others (nbval, dash,
-    # pytest-benchmark, xdist) have no say in a grade, and importing them costs 0.2 s a grade.
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
-    completed = subprocess.run(
-        command, cwd=REPO_ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
-    )
-    return completed.returncode, completed.stdout
-
-
-def format_report(summary, title):
-    lines = [title, ""]
-    width = max((len(t["name"]) for t in summary["tests"]), default=10)
-    for test in summary["tests"]:
-        status = "ok  " if test["status"] == "passed" else "FAIL"
-        output = test["output"].splitlines()
-        first = f"  {output[0]}" if output else ""
-        lines.append(f"{test['score']:5.1f}/{test['max_score']:<4.1f} {status} {test['name']:<{width}}{first}".rstrip())
-        lines.extend(" " * (width + 17) + "  " + line for line in output[1:])
-    lines += ["", f"Total: {summary['score']:g} / {max_score(summary):g}"]
-    output = summary.get("output", "").splitlines()
-    per_function = [line for line in output if line.startswith("- ")]
-    notes = [line for line in output if not line.startswith("- ")]
-    if per_function:
-        lines += ["", "Per function:", *(f"  {line[2:].replace('`', '')}" for line in per_function)]
-    lines += notes  # how the submission was isolated: the last line, where it is seen
-    return "\n".join(lines)
 
 
 def grade(args):
@@ -197,12 +100,12 @@ def grade(args):
         print(output, file=sys.stderr)
         print(f"error: the grading run broke (pytest exit code {code})", file=sys.stderr)
         return 1
-    summary = json.loads(results.read_text())
+    graded = Grading.from_gradescope(json.loads(results.read_text()))
     title = f"Grading {impl_dir}" + "".join(f" (with {o})" for o in args.impl_module)
-    print(format_report(summary, title))
+    print(graded.to_table(title))
     if args.results:
         print(f"Results written to {results}")
-    if args.require_full and summary["score"] < max_score(summary):
+    if args.require_full and graded.score < graded.max_score:
         return 1
     return 0
 
@@ -223,7 +126,7 @@ def write_gradebook(path, assignment, graded, roster=None):
     ``SIS Login ID``.
     """
     marks = {name: summary for name, summary, _ in graded}
-    possible = max((max_score(s) for s in marks.values() if s), default=0)
+    possible = max((s.max_score for s in marks.values() if s), default=0)
     rows = []
     if roster:
         with open(roster, newline="", encoding="utf-8-sig") as handle:
@@ -239,11 +142,11 @@ def write_gradebook(path, assignment, graded, roster=None):
             name = next((key for key in keys if key and key in marks), None)
             summary = marks.get(name)
             matched.add(name)
-            rows.append([*(student.get(c, "") for c in GRADEBOOK_IDENTITY), f"{summary['score']:g}" if summary else ""])
+            rows.append([*(student.get(c, "") for c in GRADEBOOK_IDENTITY), f"{summary.score:g}" if summary else ""])
         for name in sorted(set(marks) - matched):
             print(f"{name}: in no roster row (by SIS Login ID, SIS User ID or ID): not in the gradebook file")
     else:
-        rows = [[name, "", "", name, "", f"{s['score']:g}" if s else ""] for name, s in marks.items()]
+        rows = [[name, "", "", name, "", f"{s.score:g}" if s else ""] for name, s in marks.items()]
     with open(path, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow([*GRADEBOOK_IDENTITY, assignment])
@@ -263,7 +166,7 @@ def batch(args):
     jobs = max(1, min(args.jobs or os.cpu_count() or 1, config.SANDBOX_UID_SLOTS))
     require = not args.allow_unisolated
     if require:
-        from grading.sandbox import isolation
+        from grading.sandbox import UID, isolation, permission_wall
 
         level = isolation()
         if not level.isolated:
@@ -271,6 +174,15 @@ def batch(args):
                 f"error: refusing to grade the class: submissions could not be isolated "
                 f"({level.reason}); --allow-unisolated grades anyway, as a local check"
             )
+        if level.level == UID:
+            # No namespace hides the class here: its folders must be out of the sandbox uids' reach.
+            os.chmod(out, 0o700)
+            wall = permission_wall(level.uid, [root, out])
+            if wall is not None:
+                raise SystemExit(
+                    f"error: refusing to grade the class: {wall.split(':')[0]}: make {root} unreadable "
+                    f"to others (chmod 700 {root}), so that no submission reads a classmate's"
+                )
     # One dedicated sandbox uid per parallel slot: two submissions graded at
     # once never share a uid, and whatever one left running is killed before
     # its slot grades the next.
@@ -289,13 +201,13 @@ def batch(args):
             slots.put(uid)
         if code not in (0, 1) or not results.exists():
             return submission.name, None, output
-        return submission.name, json.loads(results.read_text()), output
+        return submission.name, Grading.from_gradescope(json.loads(results.read_text())), output
 
     # Each grading is its own pytest process: threads only wait for them.
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         graded = list(pool.map(grade_one, submissions))
 
-    functions = [f for f in GRADED_FUNCTIONS if any(r and f in points_per_function(r["tests"]) for _, r, _ in graded)]
+    functions = [f for f in GRADED_FUNCTIONS if any(r and f in r.per_function() for _, r, _ in graded)]
     csv_path = Path(args.csv) if args.csv else out / "marks.csv"
     with open(csv_path, "w", newline="") as handle:
         writer = csv.writer(handle)
@@ -304,12 +216,12 @@ def batch(args):
             if summary is None:
                 writer.writerow([name, 0, "", "grading failed", *[""] * len(functions)])
                 continue
-            per_function = points_per_function(summary["tests"])
+            per_function = summary.per_function()
             writer.writerow(
                 [
                     name,
-                    f"{summary['score']:g}",
-                    f"{max_score(summary):g}",
+                    f"{summary.score:g}",
+                    f"{summary.max_score:g}",
                     "graded",
                     *[f"{per_function.get(f, (0, 0))[0]:g}" for f in functions],
                 ]
@@ -317,7 +229,7 @@ def batch(args):
     if args.gradebook:
         write_gradebook(args.gradebook, args.assignment, graded, args.roster)
     for name, summary, output in graded:
-        mark = f"{summary['score']:g} / {max_score(summary):g}" if summary else "grading failed"
+        mark = f"{summary.score:g} / {summary.max_score:g}" if summary else "grading failed"
         print(f"{name}: {mark}")
         if summary is None:
             print(output, file=sys.stderr)

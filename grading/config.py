@@ -33,8 +33,14 @@ EXERCISE_MODULES = tuple(dict.fromkeys(GRADED_FUNCTIONS.values()))  # pcl_course
 HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")
 
 # -- time limits ------------------------------------------------------------------
-TEST_TIMEOUT = 60.0  # seconds of one graded test (pytest-timeout), ample for plain loops
-CALL_TIMEOUT = 30.0  # wall-clock seconds of one sandboxed call (its module's import included)
+# Wall-clock seconds of one graded test: a backstop above the calls' own CPU limits
+# (CALL_TIMEOUT), for the grader's side of a test (trusted code in-process).
+TEST_TIMEOUT = 240.0
+CALL_TIMEOUT = 30.0  # CPU seconds of one sandboxed call (its module's import included), all its threads
+# A call is also stopped after CALL_WALL_FACTOR times as many wall-clock seconds: a
+# backstop for a call that waits (sleeps, blocks) rather than computes. CPU time
+# does not grow with the machine's load, so neither does a mark.
+CALL_WALL_FACTOR = 4.0
 MAX_FEEDBACK_LINES = 12  # of one failed test's feedback
 # Values (array entries) of one call's arguments kept for the diagnosis
 # (grading/diagnosis.py); larger calls are recorded without their arguments.
@@ -50,7 +56,13 @@ CPU_LIMIT = 600  # CPU seconds for a worker's whole life
 PROCESS_LIMIT = 256  # processes of the sandbox user (fork bombs)
 FILE_SIZE_LIMIT = 256 * 1024**2  # bytes of any one file the worker writes
 TMP_SIZE = 256 * 1024**2  # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
-ANSWER_LIMIT = 1024**3  # bytes of one answer the grader accepts from a worker
+# What the grader reads from a worker, every size checked before anything is allocated
+# (grading/sandbox.py): the grader's own memory stays bounded whatever a worker sends.
+ANSWER_LIMIT = 128 * 1024**2  # bytes of all the arrays of one answer
+HEADER_LIMIT = 1024**2  # bytes of one answer's JSON header
+MAX_ARRAYS = 4096  # arrays (and modified arguments) in one answer
+MAX_TEXT = 2000  # characters kept of an exception's type, message or place
+STDERR_TAIL_BYTES = 64 * 1024  # of the worker's stderr, read from its end after a crash
 
 # The dedicated, unprivileged uids that run submissions when the grader is
 # root: one per parallel job slot of `batch`, never shared with another

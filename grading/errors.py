@@ -7,7 +7,20 @@ wrong and, where it can, what to do.
 
 class SandboxError(Exception):
     """The worker failed: a timeout, a crash, a module that cannot be imported,
-    an answer that is not plain data, or no isolation where it is required."""
+    an answer that is not plain data, or no isolation where it is required.
+
+    :attr:`kind` says which, without any text of the submission's
+    (``grading.sandbox``'s kinds): what a hidden test may show.
+    """
+
+    # The kinds of failure.
+    TIMEOUT, DIED, GARBLED, TOO_LARGE = "timeout", "died", "garbled", "too large"
+    UNSUPPORTED, IMPORT, STRAY, GENERATOR, RAISED = "unsupported", "import", "stray", "generator", "raised"
+    REFUSED = "refused"  # no isolation where it is required
+
+    def __init__(self, message, kind=GARBLED):
+        super().__init__(message)
+        self.kind = kind
 
 
 class StagingError(Exception):
@@ -26,6 +39,7 @@ class CheckFailed(AssertionError):
     def __init__(self, message, rule=None):
         super().__init__(message)
         self.rule = rule if rule is not None else message.splitlines()[0]
+        self.public_rule = rule  # given explicitly, so free of values: what a hidden test may show
 
 
 class NotImplementedYet(Exception):
@@ -49,3 +63,17 @@ class ForbiddenAPI(Exception):
             f"forbidden API in {module}.py ({shown}): write your own code; Open3D, PCL and "
             "scikit-learn are allowed for visualisation only, outside the exercise modules"
         )
+
+
+class DidNotRaise(CheckFailed):
+    """A call that had to raise (bad input) returned normally (:func:`grading.checks.raises`)."""
+
+
+class TestTimeout(Exception):
+    """A graded test ran past its time limit (the plugin's timer for pytest-timeout)."""
+
+    __test__ = False  # not a test class, whatever pytest collects
+
+    def __init__(self, seconds):
+        super().__init__(f"timed out: the test ran for more than {seconds:g} s")
+        self.seconds = seconds

@@ -36,6 +36,8 @@ from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
 from grading.leakcheck import find_leaks
 from grading.release import IGNORED, _substitute
+from grading.results import Grading, clean
+from grading.runner import run_graded_tests
 from grading.staging import read_regular_file, stage
 
 TEMPLATES = Path(__file__).with_name("templates") / "gradescope"
@@ -253,13 +255,8 @@ def assemble(submission, into):
 
 
 def _failure_results(message, started):
-    return {
-        "score": 0.0,
-        "execution_time": round(time.monotonic() - started),
-        "output": message,
-        "stdout_visibility": "hidden",
-        "tests": [],
-    }
+    grading = Grading(note=clean(message), execution_time=time.monotonic() - started)
+    return grading.to_gradescope()
 
 
 def _write_json(path, content):
@@ -277,7 +274,6 @@ def autograde(root="/autograder", budget=None):
     or a container where it cannot be isolated) still gets a results file,
     with score 0 and one line that says why.
     """
-    from grading.cli import run_graded_tests  # the cli imports this module's archive builder
     from grading.sandbox import isolation
 
     started = time.monotonic()

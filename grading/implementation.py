@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
-from grading.diagnosis import Call, changed, size_of, snapshot
+from grading.diagnosis import Call, contract_signature, size_of, snapshot
 from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
 from grading.forbidden import scan_package
 
@@ -41,6 +41,58 @@ def describe_call(name, args, kwargs):
     return f"{name}({', '.join(parts)})"
 
 
+def _private_copy(value):
+    """``value`` with every array copied (its writeable flag kept); generators and scalars shared."""
+    if type(value) is np.ndarray:
+        copied = value.copy()
+        copied.flags.writeable = value.flags.writeable
+        return copied
+    if type(value) in (tuple, list):
+        return type(value)(_private_copy(item) for item in value)
+    if type(value) is dict:
+        return {key: _private_copy(item) for key, item in value.items()}
+    return value
+
+
+def _modified(before, after, path=()):
+    """Paths of the arrays of ``after`` that differ from those of ``before`` (same structure)."""
+    if type(before) is np.ndarray:
+        same = before.shape == after.shape and np.array_equal(before, after, equal_nan=before.dtype.kind in "fc")
+        return [] if same else [list(path)]
+    if type(before) in (tuple, list):
+        return [p for i, (b, a) in enumerate(zip(before, after)) for p in _modified(b, a, (*path, i))]
+    if type(before) is dict:
+        return [p for key in before for p in _modified(before[key], after[key], (*path, key))]
+    return []
+
+
+def _call_on_copies(function, args, kwargs):
+    """Call trusted code on private copies of the arguments, as the worker does: (result, modified paths)."""
+    arguments = {"args": list(args), "kwargs": dict(kwargs)}
+    copies = _private_copy(arguments)
+    try:
+        result = function(*copies["args"], **copies["kwargs"])
+    except BaseException as exc:
+        exc.modified = _modified(arguments, copies)
+        raise
+    return result, _modified(arguments, copies)
+
+
+def argument_names(function, paths):
+    """The contract's names of the arguments at ``paths`` (``["args", i, ...]`` or ``["kwargs", name, ...]``)."""
+    try:
+        parameters = list(contract_signature(function).parameters)
+    except (ImportError, AttributeError, ValueError):
+        parameters = []
+    names = set()
+    for path in paths:
+        if len(path) >= 2 and path[0] == "args" and type(path[1]) is int:
+            names.add(parameters[path[1]] if path[1] < len(parameters) else f"argument {path[1] + 1}")
+        elif len(path) >= 2 and path[0] == "kwargs":
+            names.add(str(path[1])[:100])
+    return sorted(names)
+
+
 def _where_in(exc, impl):
     """file:line of the innermost frame of the implementation in ``exc``'s traceback."""
     roots = [impl.directory, *impl.overrides.values()]
@@ -61,6 +113,13 @@ class Implementation:
     recorded (:attr:`last_call`) for feedback; a stub's
     ``NotImplementedError`` becomes :class:`NotImplementedYet`.
 
+    The caller's arguments are frozen: the function works on private copies
+    (in the worker, or copied here for trusted code), so that a test's
+    expected values, computed from its inputs after the call, are those of
+    the inputs it made. Whether the call modified an argument is a verdict
+    of its own, :attr:`last_modified` (the in-place tests read it). A random
+    generator is shared, so that a later call draws on from it.
+
     Parameters
     ----------
     directory : path
@@ -76,6 +135,7 @@ class Implementation:
         self.package = f"_graded_impl_{next(_counter)}"
         self._modules = {}
         self.last_call = None
+        self.last_modified = []  # names of the arguments the last call modified in place
         self.sandboxed = sandbox
         self.current_test = None  # set by the plugin: the test under way
         self.calls = {}  # graded function -> [Call], for the diagnosis
@@ -147,19 +207,23 @@ class Implementation:
                 raise StudentError(f"the submission has no module {module_name}.py")
 
             def function(*args, **kwargs):
-                return self.worker.call(module_name, name, args, kwargs)
+                return self.worker.call(module_name, name, args, kwargs), self.worker.last_modified
         else:
-            function = getattr(self.module(module_name), name, None)
-            if function is None:
+            loaded = getattr(self.module(module_name), name, None)
+            if loaded is None:
                 raise StudentError(f"{GRADED_FUNCTIONS[name]}.py defines no function {name}")
+
+            def function(*args, **kwargs):
+                return _call_on_copies(loaded, args, kwargs)
 
         def graded_call(*args, **kwargs):
             self.last_call = describe_call(name, args, kwargs)
+            self.last_modified, modified = [], []
             kept = snapshot(args, kwargs)
             call = Call(self.current_test, *(kept or ((), {})), kept=kept is not None)
             self.calls.setdefault(name, []).append(call)
             try:
-                result = function(*args, **kwargs)
+                result, modified = function(*args, **kwargs)
             except NotImplementedError:
                 call.error_type, call.error = "NotImplementedError", "not implemented"
                 raise NotImplementedYet(name) from None
@@ -167,10 +231,11 @@ class Implementation:
                 call.error_type = type(exc).__name__
                 call.error = (str(exc).splitlines() or [""])[0][:200]
                 call.where = getattr(exc, "where", None) or _where_in(exc, self)
+                modified = getattr(exc, "modified", [])
                 raise
             finally:
-                if kept is not None:
-                    call.modified = changed(kept[0], args) or changed(list(kept[1].values()), list(kwargs.values()))
+                self.last_modified = argument_names(name, modified)
+                call.modified = bool(self.last_modified)
             if kept is not None and size_of(result) <= config.DIAGNOSIS_MAX_VALUES:
                 call.result = copy.deepcopy(result)
             else:  # too large to keep: the call is not replayed by the diagnosis
@@ -195,6 +260,6 @@ class Implementation:
 
     def close(self):
         if self.worker is not None:
-            self.worker.stop()
+            self.worker.close()
         if self.staged is not None:
             shutil.rmtree(self.staged.root, ignore_errors=True)

@@ -25,6 +25,7 @@ Markers
 
 import json
 import os
+import signal
 import tempfile
 import time
 from pathlib import Path
@@ -34,8 +35,17 @@ import pytest
 from grading import GRADED_FUNCTIONS, diagnosis
 from grading import config as grading_config
 from grading.diagnosis import Outcome
-from grading.errors import CheckFailed, ForbiddenAPI, NotImplementedYet, SandboxError, StagingError
+from grading.errors import (
+    CheckFailed,
+    DidNotRaise,
+    ForbiddenAPI,
+    NotImplementedYet,
+    SandboxError,
+    StagingError,
+    TestTimeout,
+)
 from grading.implementation import Implementation
+from grading.results import HIDDEN_NOTE, Grading, TestResult, clean
 
 try:
     from grading import mistakes
@@ -47,6 +57,7 @@ _RESULTS_KEY = pytest.StashKey[dict]()
 _OUTCOMES_KEY = pytest.StashKey[dict]()  # test id -> diagnosis.Outcome
 _DIAGNOSES_KEY = pytest.StashKey[dict]()  # function -> its diagnosis, once the tests are over
 _STARTED_KEY = pytest.StashKey[float]()
+_ALARM_KEY = pytest.StashKey[object]()  # a graded test's previous SIGALRM handler, while its timer runs
 
 
 def pytest_addoption(parser):
@@ -106,6 +117,13 @@ def pytest_addoption(parser):
         help="a first line of the results' output (e.g. which files of an upload were graded)",
     )
     group.addoption(
+        "--grading-options",
+        default=None,
+        metavar="FILE",
+        help="a JSON file of options (impl, results, submission_note) that name a submission's paths: "
+        "kept off the command line, which any process can read in /proc",
+    )
+    group.addoption(
         "--require-isolation",
         action="store_true",
         help="refuse to grade unless the submission runs isolated (bubblewrap or a dedicated uid)",
@@ -123,9 +141,23 @@ def pytest_configure(config):
     config.stash[_RESULTS_KEY] = {}
 
 
+_OPTIONS_KEY = pytest.StashKey[dict]()
+
+
+def grading_option(config, name):
+    """An option of this grading: from the ``--grading-options`` file when given
+    (:func:`grading.runner.run_graded_tests` writes it, readable by the grader only),
+    else from the command line (``--impl``, ``--results``, ``--submission-note``)."""
+    if _OPTIONS_KEY not in config.stash:
+        path = config.getoption("--grading-options")
+        config.stash[_OPTIONS_KEY] = json.loads(Path(path).read_text()) if path else {}
+    options = config.stash[_OPTIONS_KEY]
+    return options[name] if name in options else config.getoption(f"--{name.replace('_', '-')}")
+
+
 def _implementation(config):
     if _IMPL_KEY not in config.stash:
-        directory = config.getoption("--impl")
+        directory = grading_option(config, "impl")
         directory = Path(directory) if directory else config.rootpath / "pcl_course"
         overrides = {}
         for item in config.getoption("--impl-module"):
@@ -143,7 +175,8 @@ def _implementation(config):
         config.stash[_IMPL_KEY] = impl
         if impl.isolation is not None and not impl.isolation.isolated and config.getoption("--require-isolation"):
             impl.refusal = SandboxError(
-                f"refusing to grade: the submission could not be isolated ({impl.isolation.reason})"
+                f"refusing to grade: the submission could not be isolated ({impl.isolation.reason})",
+                kind=SandboxError.REFUSED,
             )
     return config.stash[_IMPL_KEY]
 
@@ -212,29 +245,48 @@ def _location_in_implementation(excinfo, impl):
     return None
 
 
-def _hidden_feedback(excinfo):
-    """A hidden test's feedback: which rule broke, never a value of its inputs or answers.
+# What a hidden test says of a sandbox failure: fixed words per kind, no text of the submission's.
+_HIDDEN_SANDBOX = {
+    SandboxError.TIMEOUT: "timed out",
+    SandboxError.DIED: "the submission's process died",
+    SandboxError.GARBLED: "the answer could not be read",
+    SandboxError.TOO_LARGE: "the answer was too large",
+    SandboxError.UNSUPPORTED: "the answer was not plain numbers and arrays",
+    SandboxError.IMPORT: "the module could not be imported",
+    SandboxError.STRAY: "processes or threads were left running",
+    SandboxError.GENERATOR: "the random generator was set, not drawn from",
+    SandboxError.RAISED: "raised an exception",
+}
 
-    The check helpers say which rule broke (:attr:`CheckFailed.rule`); the
-    grader's own messages are values-free in their first line; an exception
-    of the submission is shown by its type and place only, since its message
-    may print the hidden inputs.
+
+def _hidden_feedback(excinfo):
+    """A hidden test's feedback: which rule broke, in the grader's words only.
+
+    Never a value of its inputs or answers, and no text the submission
+    produced (an exception's message, type or place, a file name, its
+    output): a hidden test's inputs are fixed, so any such text could carry
+    them out. The public tests say the rest.
     """
     exc = excinfo.value
-    if isinstance(exc, CheckFailed):
-        text = exc.rule
-    elif isinstance(exc, (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError)):
-        text = str(exc).splitlines()[0].split("; its last output")[0]
-    elif excinfo.typename == "Failed" and str(exc).startswith("Timeout"):
-        text = "timed out"
-    elif excinfo.typename == "Failed" and str(exc).startswith("DID NOT RAISE"):
+    if isinstance(exc, DidNotRaise):
         text = "expected the call to raise an error, but it returned normally"
+    elif isinstance(exc, CheckFailed):
+        text = exc.public_rule or "a check of the answer failed"
+    elif isinstance(exc, NotImplementedYet):
+        text = "not implemented"
+    elif isinstance(exc, ForbiddenAPI):
+        text = "the module uses a forbidden API (the public tests say which)"
+    elif isinstance(exc, StagingError):
+        text = "the submission was refused (the public tests say why)"
+    elif isinstance(exc, SandboxError):
+        text = _HIDDEN_SANDBOX.get(exc.kind, "the call failed")
+    elif isinstance(exc, TestTimeout):
+        text = "timed out"
     elif isinstance(exc, AssertionError):
         text = "a check of the answer failed"
     else:
-        where = getattr(exc, "where", None)
-        text = f"raised {excinfo.typename}" + (f" at {where}" if where else "")
-    return f"{text[:200]} (hidden test: details withheld)"
+        text = "raised an exception"
+    return f"{text} {HIDDEN_NOTE}"
 
 
 def _feedback(excinfo, impl):
@@ -246,11 +298,8 @@ def _feedback(excinfo, impl):
     text = str(exc).strip()
     if isinstance(exc, SandboxError):
         return f"{text}{last_call}"
-    if excinfo.typename == "Failed" and text.startswith("Timeout"):
-        return f"timed out: {text.splitlines()[0]}{last_call}"
-    if excinfo.typename == "Failed" and text.startswith("DID NOT RAISE"):
-        expected = text.removeprefix("DID NOT RAISE").strip()
-        return f"expected the call to raise {expected}, but it returned normally{last_call}"
+    if isinstance(exc, TestTimeout):
+        return f"{text}{last_call}"
     if isinstance(exc, AssertionError):
         lines = text.splitlines()
         # pytest appends its introspection ("assert ...", "+ where ...") to a
@@ -267,94 +316,103 @@ def _feedback(excinfo, impl):
 
 
 def _outcome(excinfo):
-    """How a test failed, for the diagnosis (:class:`grading.diagnosis.Outcome`)."""
+    """How a test failed, for the diagnosis (:class:`grading.diagnosis.Outcome`): by the exception's class."""
     if excinfo is None:
         return Outcome(False, diagnosis.ERROR)
     exc = excinfo.value
-    text = str(exc)
-    if isinstance(exc, NotImplementedYet):
-        return Outcome(False, diagnosis.NOT_IMPLEMENTED)
-    if isinstance(exc, ForbiddenAPI):
-        return Outcome(False, diagnosis.FORBIDDEN)
-    if isinstance(exc, StagingError):
-        return Outcome(False, diagnosis.REFUSED)
-    if isinstance(exc, SandboxError):
-        return Outcome(False, diagnosis.SANDBOX)
+    for kind, classes in (
+        (diagnosis.NOT_IMPLEMENTED, NotImplementedYet),
+        (diagnosis.FORBIDDEN, ForbiddenAPI),
+        (diagnosis.REFUSED, StagingError),
+        (diagnosis.SANDBOX, SandboxError),
+        (diagnosis.DID_NOT_RAISE, DidNotRaise),
+        (diagnosis.TIMEOUT, TestTimeout),
+    ):
+        if isinstance(exc, classes):
+            return Outcome(False, kind)
     if isinstance(exc, CheckFailed):
         return Outcome(False, diagnosis.CHECK, exc.rule)
-    if excinfo.typename == "Failed" and text.startswith("DID NOT RAISE"):
-        return Outcome(False, diagnosis.DID_NOT_RAISE)
-    if excinfo.typename == "Failed" and text.startswith("Timeout"):
-        return Outcome(False, diagnosis.TIMEOUT)
     if isinstance(exc, AssertionError):
         return Outcome(False, diagnosis.ASSERTION)
     return Outcome(False, diagnosis.ERROR)
 
 
+def _run_diagnosis(config, function, tests, always):
+    """The diagnosis of ``function`` over ``tests`` (test id -> Outcome), or None."""
+    impl = config.stash.get(_IMPL_KEY, None)
+    model = mistakes.model(function) if mistakes is not None else None
+    sources = {GRADED_FUNCTIONS[function]: impl.source(GRADED_FUNCTIONS[function])}
+    if always and all(o.passed for o in tests.values()):
+        # A full-marks run, checked for false diagnoses (the project's alternatives):
+        # every test counts as failed, so any matching mistake shows.
+        tests = {nodeid: diagnosis.Outcome(False, diagnosis.CHECK) for nodeid in tests}
+    calls = [c for c in impl.calls.get(function, []) if c.test in tests]
+    try:
+        found = diagnosis.diagnose(function, calls, tests, model, sources)
+    except Exception as exc:  # the diagnosis is help, never a reason to lose a grade
+        print(f"note: the diagnosis of {function} failed: {type(exc).__name__}: {exc}")
+        return None
+    if found is None:
+        return None
+    failed = [t for t, o in tests.items() if not o.passed]
+    line = clean(diagnosis.explained_line(found, len(failed)))
+    return found, {"id": found.id, "message": line, "explains": len(found.explains)}
+
+
 def _diagnose(config):
-    """Diagnose every function that lost points; put each line into its tests' and the summary's output."""
+    """Diagnose every function that lost points.
+
+    Students see the diagnosis of the public tests only (their calls and
+    verdicts): in the top-level summary and first in each public test it
+    explains. The diagnosis of all tests, hidden ones included, is kept for
+    instructors (the results' ``extra_data`` and the terminal table).
+    """
     impl = config.stash.get(_IMPL_KEY, None)
     results = config.stash.get(_RESULTS_KEY, {})
     outcomes = config.stash.get(_OUTCOMES_KEY, {})
     if impl is None or not results:
-        return {}
+        return
     always = config.getoption("--diagnose-always")
-    found = {}
+    public, everything = {}, {}
     for function in GRADED_FUNCTIONS:
         tests = {
-            nodeid: outcomes[nodeid]
-            for nodeid, entry in results.items()
-            if entry["tags"] == [function] and nodeid in outcomes
+            nodeid: outcomes[nodeid] for nodeid, r in results.items() if r.function == function and nodeid in outcomes
         }
         if not tests or (not always and all(o.passed for o in tests.values())):
             continue
-        model = mistakes.model(function) if mistakes is not None else None
-        sources = {GRADED_FUNCTIONS[function]: impl.source(GRADED_FUNCTIONS[function])}
-        if always and all(o.passed for o in tests.values()):
-            # A full-marks run, checked for false diagnoses (the project's alternatives):
-            # every test counts as failed, so any matching mistake shows.
-            tests = {nodeid: diagnosis.Outcome(False, diagnosis.CHECK) for nodeid in tests}
-        try:
-            found_here = diagnosis.diagnose(function, impl.calls.get(function, []), tests, model, sources)
-        except Exception as exc:  # the diagnosis is help, never a reason to lose a grade
-            found_here = None
-            print(f"note: the diagnosis of {function} failed: {type(exc).__name__}: {exc}")
-        if found_here is None:
-            continue
-        failed = [t for t, o in tests.items() if not o.passed]
-        line = diagnosis.explained_line(found_here, len(failed))
-        found[function] = {"id": found_here.id, "message": line, "explains": len(found_here.explains)}
-        for nodeid in found_here.explains:
-            entry = results.get(nodeid)
-            if entry is None or entry["status"] != "failed" or always or found_here.id in diagnosis.ONE_LINE_ALREADY:
-                continue
-            if found_here.id in diagnosis.ONE_CAUSE:
-                entry["output"] = f"diagnosis: {line}"  # the same cause everywhere: said once, not repeated
-            else:
-                entry["output"] = f"diagnosis: {line}\n{entry['output']}"
-    config.stash[_DIAGNOSES_KEY] = found
-    return found
+        visible = {nodeid: o for nodeid, o in tests.items() if not results[nodeid].hidden}
+        found = _run_diagnosis(config, function, visible, always) if visible else None
+        if found is not None:
+            public[function] = found[1]
+            for nodeid in found[0].explains:
+                result = results[nodeid]
+                if result.passed or always or found[0].id in diagnosis.ONE_LINE_ALREADY:
+                    continue
+                result.diagnosis = found[1]["message"]
+                if found[0].id in diagnosis.ONE_CAUSE:
+                    result.feedback = ""  # the same cause everywhere: said once, not repeated
+        hidden_failed = any(results[n].hidden and not o.passed for n, o in tests.items())
+        if hidden_failed or always:
+            found_all = _run_diagnosis(config, function, tests, always)
+            if found_all is not None:
+                everything[function] = found_all[1]
+        elif function in public:
+            everything[function] = public[function]
+    config.stash[_DIAGNOSES_KEY] = (public, everything)
 
 
-NOT_RUN = "not run: grading stopped before this test"
-
-
-def _new_entry(item, number):
-    return {
-        "name": item.name,
-        "number": number,
-        "score": 0.0,
-        "max_score": _points(item),
-        "status": "failed",
-        "output": NOT_RUN,
-        "output_format": "md",
-        "tags": [graded_function(item)],
-        "visibility": "after_published" if is_hidden(item) else "visible",
-    }
+def _new_result(item, number):
+    return TestResult(
+        name=item.name,
+        number=number,
+        function=graded_function(item),
+        max_score=_points(item),
+        hidden=is_hidden(item),
+    )
 
 
 def pytest_collection_finish(session):
-    """Every graded test gets its result entry now, as not run, numbered
+    """Every graded test gets its result now, as not run, numbered
     ``<function>.<test>`` in the contract's order: a run killed later still
     leaves a complete, valid results file."""
     results = session.config.stash[_RESULTS_KEY]
@@ -364,7 +422,7 @@ def pytest_collection_finish(session):
         function = graded_function(item)
         if _is_graded(item) and function in GRADED_FUNCTIONS:  # unmarked ones stopped the run already
             counts[function] = counts.get(function, 0) + 1
-            results[item.nodeid] = _new_entry(item, f"{functions.index(function) + 1}.{counts[function]}")
+            results[item.nodeid] = _new_result(item, f"{functions.index(function) + 1}.{counts[function]}")
     session.config.stash[_STARTED_KEY] = time.monotonic()
     _write_results(session.config, final=False)
 
@@ -385,6 +443,29 @@ def pytest_runtest_setup(item):
         pytest.skip(f"not run: the submission's time budget of {item.config.getoption('--budget'):g} s ran out")
 
 
+def pytest_timeout_set_timer(item, settings):
+    """A graded test's time limit raises :class:`TestTimeout` (pytest-timeout's hook):
+    a timeout is known by its class, never by the words of a message."""
+    if not _is_graded(item) or settings.timeout <= 0:
+        return None  # pytest-timeout's own timer
+
+    def expire(signum, frame):
+        raise TestTimeout(settings.timeout)
+
+    item.stash[_ALARM_KEY] = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, settings.timeout)
+    return True
+
+
+def pytest_timeout_cancel_timer(item):
+    if _ALARM_KEY not in item.stash:
+        return None
+    signal.setitimer(signal.ITIMER_REAL, 0)
+    signal.signal(signal.SIGALRM, item.stash[_ALARM_KEY])
+    del item.stash[_ALARM_KEY]
+    return True
+
+
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
     outcome = yield
@@ -393,74 +474,52 @@ def pytest_runtest_makereport(item, call):
     report = outcome.get_result()
     results = item.config.stash[_RESULTS_KEY]
     if item.nodeid not in results:
-        results[item.nodeid] = _new_entry(item, f"0.{len(results) + 1}")
-    entry = results[item.nodeid]
+        results[item.nodeid] = _new_result(item, f"0.{len(results) + 1}")
+    result = results[item.nodeid]
     outcomes = item.config.stash.setdefault(_OUTCOMES_KEY, {})
     if report.when == "call" and report.passed:
-        entry.update(score=entry["max_score"], status="passed", output="")
+        result.score, result.passed, result.feedback = result.max_score, True, ""
         outcomes[item.nodeid] = Outcome(True)
     elif report.failed:
         impl = item.config.stash.get(_IMPL_KEY, None)
         if not call.excinfo:
             message = "failed"
-        elif is_hidden(item):
+        elif result.hidden:
             message = _hidden_feedback(call.excinfo)
         else:
             message = _feedback(call.excinfo, impl)
         if report.when != "call":
             message = f"error in test {report.when}: {message}"
-        entry.update(score=0.0, status="failed", output=message)
+        result.score, result.passed = 0.0, False
+        result.set_feedback(message)
         outcomes[item.nodeid] = _outcome(call.excinfo)
         outcomes[item.nodeid].interface = item.get_closest_marker("interface") is not None
         if isinstance(
-            call.excinfo.value if call.excinfo else None, (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError)
+            call.excinfo.value if call.excinfo else None,
+            (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError, TestTimeout),
         ):
-            report.longrepr = message  # one line, not a traceback
+            report.longrepr = result.feedback  # one line, not a traceback
     elif report.skipped and report.when != "teardown":
         reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else "skipped"
         reason = reason.removeprefix("Skipped: ")
-        entry.update(score=0.0, status="failed", output=reason if reason.startswith("not run:") else "skipped")
+        result.score, result.passed = 0.0, False
+        result.set_feedback(reason if reason.startswith("not run:") else "skipped")
     if report.when == "teardown":  # once per test, its verdict final
         _write_results(item.config, final=False)
 
 
-def points_per_function(tests):
-    """Score and maximum per graded function (each test's ``tags``), from result entries."""
-    totals = {}
-    for test in tests:
-        function = (test.get("tags") or ["other"])[0]
-        score, maximum = totals.get(function, (0.0, 0.0))
-        totals[function] = (score + test["score"], maximum + test["max_score"])
-    return totals
-
-
-def max_score(summary):
-    """The most a results file's tests can score (Gradescope's format has no top-level field for it)."""
-    return sum(test["max_score"] for test in summary["tests"])
-
-
-def results_summary(results, isolation=None, execution_time=None, note=None, diagnoses=None):
-    """The results file's content (Gradescope's format), from the per-test entries."""
-    tests = list(results.values())
-    per_function = points_per_function(tests)
-    diagnoses = diagnoses or {}
-    lines = [line for line in (note, isolation) if line]
-    order = list(GRADED_FUNCTIONS)
-    lines += [
-        f"- `{function}`: {score:g} / {maximum:g}"
-        + (f" - {diagnoses[function]['message']}" if function in diagnoses else "")
-        for function, (score, maximum) in sorted(per_function.items(), key=lambda kv: order.index(kv[0]))
-    ]
-    summary = {
-        "score": sum(t["score"] for t in tests),
-        "execution_time": round(execution_time) if execution_time is not None else 0,
-        "output": "\n".join(lines),
-        "stdout_visibility": "hidden",
-        "tests": tests,
-    }
-    if diagnoses:
-        summary["extra_data"] = {"diagnoses": diagnoses}
-    return summary
+def grading_of(config):
+    """The :class:`grading.results.Grading` of this session so far."""
+    started = config.stash.get(_STARTED_KEY, None)
+    public, everything = config.stash.get(_DIAGNOSES_KEY, ({}, {}))
+    return Grading(
+        tests=list(config.stash.get(_RESULTS_KEY, {}).values()),
+        isolation=isolation_note(config) or "",
+        note=clean(grading_option(config, "submission_note") or ""),
+        diagnoses=public,
+        all_diagnoses=everything,
+        execution_time=time.monotonic() - started if started is not None else 0.0,
+    )
 
 
 def _write_results(config, final=True):
@@ -472,23 +531,15 @@ def _write_results(config, final=True):
     (the C encoder: ``indent`` would take the pure-Python one, about 0.5 s over a
     grade), and the final one is indented for people to read.
     """
-    path = config.getoption("--results")
+    path = grading_option(config, "results")
     if not path or hasattr(config, "workerinput"):
         return
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    started = config.stash.get(_STARTED_KEY, None)
-    elapsed = time.monotonic() - started if started is not None else None
-    summary = results_summary(
-        config.stash.get(_RESULTS_KEY, {}),
-        isolation_note(config),
-        elapsed,
-        config.getoption("--submission-note"),
-        config.stash.get(_DIAGNOSES_KEY, None),
-    )
+    content = grading_of(config).to_gradescope()
     fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
     with os.fdopen(fd, "w") as handle:
-        handle.write(json.dumps(summary, indent=2 if final else None))
+        handle.write(json.dumps(content, indent=2 if final else None))
     os.replace(temporary, path)
 
 
@@ -505,14 +556,8 @@ def pytest_sessionfinish(session, exitstatus):
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
-    results = config.stash.get(_RESULTS_KEY, {})
-    if not results:
+    if not config.stash.get(_RESULTS_KEY, {}):
         return
-    summary = results_summary(results)
     terminalreporter.write_sep("=", "marks")
-    note = isolation_note(config)
-    if note:
-        terminalreporter.write_line(note)
-    for test in summary["tests"]:
-        terminalreporter.write_line(f"{test['score']:5.1f} / {test['max_score']:<4.1f} {test['name']}")
-    terminalreporter.write_line(f"Total: {summary['score']:g} / {max_score(summary):g}")
+    for line in grading_of(config).to_table("").splitlines()[2:]:
+        terminalreporter.write_line(line)

@@ -42,7 +42,6 @@ the same message.
 """
 
 import builtins
-import io
 import json
 import os
 import pickle
@@ -186,33 +185,74 @@ def _masked_entries(site):
     return sorted(masked)
 
 
+def _system_roots():
+    """The system's library folders that exist here (bound into the sandbox as they are)."""
+    return [path for path in ("/usr/lib", "/usr/lib64", "/usr/lib32") if Path(path).is_dir()]
+
+
+def _import_roots():
+    """(host folder, sandbox folder) of every folder the sandbox could import from."""
+    base = Path(sys.base_prefix).resolve()
+    return [(Path(p), p) for p in _system_roots()] + [(base, SANDBOX_PYTHON_ROOT), (_site_packages(), SANDBOX_SITE)]
+
+
+@cache
+def masked_paths():
+    """Every entry, in every folder the sandbox could import from, that a submission must not
+    reach: the forbidden packages and the editable install's files (:func:`_masked_entries`)."""
+    found = []
+    for root, _ in _import_roots():
+        for site_dir in _site_dirs(root):
+            found += [entry for entry in _masked_entries(site_dir) if entry not in found]
+    return tuple(found)
+
+
 @cache
 def _environment_binds():
     """The options that bind the interpreter, the system libraries and the
     site-packages, with every forbidden package masked: the same for every
     worker of this process, and slow to find (every distribution's metadata
     is read), so found once."""
-    base = Path(sys.base_prefix).resolve()
-    site = _site_packages()
     options = []
-    system = [("/usr/lib", "/usr/lib"), ("/usr/lib64", "/usr/lib64"), ("/usr/lib32", "/usr/lib32")]
-    system = [(source, target) for source, target in system if Path(source).is_dir()]
-    for source, target in system:
-        options += ["--ro-bind", source, target, "--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
+    for source in _system_roots():
+        options += ["--ro-bind", source, source, "--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
     options += ["--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache"]
-    mounts = [(base, SANDBOX_PYTHON_ROOT), (site, SANDBOX_SITE)]
-    for source, target in mounts:
+    roots = _import_roots()
+    for source, target in roots[len(_system_roots()) :]:
         options += ["--ro-bind", str(source), target]
     # Mask the forbidden packages wherever the sandbox could import them from.
-    for source_root, target_root in [(Path(s), t) for s, t in system] + mounts:
-        for site_dir in _site_dirs(Path(source_root)):
-            for entry in _masked_entries(site_dir):
-                target = f"{target_root}/{entry.relative_to(source_root)}"
-                if entry.is_dir() and not entry.is_symlink():
-                    options += ["--tmpfs", target]
-                else:
-                    options += ["--ro-bind", "/dev/null", target]
+    for entry in masked_paths():
+        source_root, target_root = next((s, t) for s, t in roots if s in entry.parents)
+        target = f"{target_root}/{entry.relative_to(source_root)}"
+        if entry.is_dir() and not entry.is_symlink():
+            options += ["--tmpfs", target]
+        else:
+            options += ["--ro-bind", "/dev/null", target]
     return tuple(options)
+
+
+def bar_sandbox_uids(paths):
+    """Deny every sandbox uid all access to ``paths`` with a POSIX ACL (``setfacl``).
+
+    Without namespaces nothing can hide a file from a process, but a named
+    ACL entry with no permission bars that one uid and changes nothing for
+    anyone else (the grader, the book's build, other users of the
+    environment). A folder barred is barred whole: nothing below it can be
+    reached. Returns None when done, else why not.
+    """
+    if not paths:
+        return None
+    if not shutil.which("setfacl"):
+        return "setfacl is not installed, to bar the sandbox uids from the forbidden packages (apt-get install acl)"
+    uids = range(config.SANDBOX_UID_BASE, config.SANDBOX_UID_BASE + config.SANDBOX_UID_SLOTS)
+    entries = ",".join(f"u:{uid}:---" for uid in uids)
+    completed = subprocess.run(
+        ["setfacl", "-P", "-m", entries, "--", *[str(p) for p in paths]], capture_output=True, text=True
+    )
+    if completed.returncode != 0:
+        why = (completed.stderr.strip().splitlines() or ["?"])[-1]
+        return f"the sandbox uids could not be barred from the forbidden packages ({why})"
+    return None
 
 
 def _bubblewrap_command(staged_root, python_argv_tail):
@@ -249,6 +289,10 @@ def _bubblewrap_command(staged_root, python_argv_tail):
         "/tmp",
         "--chdir",
         "/tmp",
+        # Last, after every bind: the root (a tmpfs of bubblewrap's, in RAM and uncapped)
+        # read-only, so that the capped /tmp is the only place the submission can write.
+        "--remount-ro",
+        "/",
     ]
     for key, value in _environment("/tmp").items():
         command += ["--setenv", key, value]
@@ -421,6 +465,44 @@ def kill_uid(uid):
         _reap()
 
 
+# The folders where any user may create files: what a dedicated uid can leave behind.
+WRITABLE_ROOTS = ("/tmp", "/var/tmp", "/dev/shm", "/run/lock", "/var/lock", "/dev/mqueue")
+
+
+def remove_files_of(uid, roots=WRITABLE_ROOTS):
+    """Remove every file and folder that ``uid`` owns below ``roots``.
+
+    A dedicated uid can create entries only where others may write: in
+    world-writable folders (recursed into) and in its own folders (removed
+    whole). Called before and after each submission in the uid mode, whose
+    processes are all dead by then, so that nothing one submission wrote is
+    there for the next one to find. Links are removed, never followed.
+    """
+    stack = [(root, 0) for root in roots]
+    while stack:
+        folder, depth = stack.pop()
+        try:
+            entries = list(os.scandir(folder))
+        except OSError:
+            continue
+        for entry in entries:
+            try:
+                info = entry.stat(follow_symlinks=False)
+            except OSError:
+                continue
+            is_folder = stat.S_ISDIR(info.st_mode)
+            if info.st_uid == uid:
+                if is_folder:
+                    shutil.rmtree(entry.path, ignore_errors=True)
+                else:
+                    try:
+                        os.unlink(entry.path)
+                    except OSError:
+                        pass
+            elif is_folder and info.st_mode & stat.S_IWOTH and depth < 32:
+                stack.append((entry.path, depth + 1))
+
+
 def _probe_script(paths):
     return (
         "import os, sys\n"
@@ -530,6 +612,8 @@ def permission_wall(uid, protected):
     lines = [line for line in completed.stdout.splitlines() if line.startswith("[")]
     readable = json.loads(lines[-1]) if lines else ["?"]
     if readable:
+        if readable[0] in {str(p) for p in masked_paths()}:
+            return f"uid {uid} can still read the forbidden package {readable[0]}"
         return (
             f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
             f"(chmod 700) and keep the Python environment outside it"
@@ -600,8 +684,12 @@ def isolation(uid=None):
         why_not = "namespaces switched off (PCL_SANDBOX_NAMESPACES=0)"
     if not root:
         return Isolation(NONE, None, f"{why_not}; the grader is not root, so no dedicated uid")
-    # The second wall: a dedicated uid that cannot read the grader's files.
-    wall = permission_wall(uid, [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()])
+    # The second wall: a dedicated uid that can read neither the grader's files nor the forbidden packages.
+    barred = bar_sandbox_uids(masked_paths())
+    if barred is not None:
+        return Isolation(NONE, None, f"{why_not}; {barred}")
+    protected = [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()]
+    wall = permission_wall(uid, [*protected, *masked_paths()])
     if wall is not None:
         return Isolation(NONE, None, f"{why_not}; {wall}")
     network = network_wall(uid)
@@ -619,7 +707,10 @@ class Worker:
         The staging folder (:class:`grading.staging.StagedSubmission` root):
         its ``pcl_course/`` is the submission.
     timeout : float
-        Wall-clock seconds of one call, its module's import included.
+        CPU seconds of one call, its module's import included, counted over
+        every process and thread of the worker: a busy machine does not
+        change a mark. ``config.CALL_WALL_FACTOR`` times as many wall-clock
+        seconds stop a call that waits without computing.
     uid : int, optional
         The preferred dedicated sandbox uid (when the grader is root).
     level : Isolation, optional
@@ -634,6 +725,9 @@ class Worker:
         self.isolation = level if level is not None else isolation(uid)
         self.uid = self.isolation.uid
         self.broken = {}  # module -> why it cannot be imported
+        self.last_modified = []
+        if self.uid is not None:
+            remove_files_of(self.uid)  # what an earlier grader, killed, may have left
 
     # -- process management ---------------------------------------------------
 
@@ -681,15 +775,14 @@ class Worker:
             cwd=self.work,
             preexec_fn=_preexec(self.uid),
         )
-        self.buffer = b""
         try:
-            header = self._read_frame(time.monotonic() + max(self.timeout, 60.0))
+            header = self._read_header(_Deadline(self, max(self.timeout, 60.0)))
             if not header.get("ready"):
-                raise SandboxError(str(header.get("error") or "the worker did not start"))
+                raise SandboxError(str(header.get("error") or "the worker did not start"), kind=GARBLED)
         except SandboxError as exc:
             self.stop()
-            raise SandboxError(f"the sandbox could not start: {exc}") from None
-        self.baseline = self._members()
+            raise SandboxError(f"the sandbox could not start: {exc}", kind=exc.kind) from None
+        self.baseline = self._tasks()
 
     def stop(self):
         if self.process is not None:
@@ -711,59 +804,82 @@ class Worker:
             shutil.rmtree(self.work, ignore_errors=True)
             self.work = None
 
+    def close(self):
+        """Stop the worker and remove every file its uid left anywhere writable."""
+        self.stop()
+        if self.uid is not None:
+            remove_files_of(self.uid)
+
     def _leftovers(self):
         if self.uid is not None:
             return any(p[3] == self.uid for p in _processes())
         return False
 
-    def _members(self):
-        """How many processes the worker runs: by its uid, else its descendants."""
+    def _pids(self):
+        """The worker's processes: those of its uid, else its process and descendants."""
         processes = _processes()
         if self.uid is not None:
-            return sum(1 for p in processes if p[3] == self.uid)
+            return [p[0] for p in processes if p[3] == self.uid]
         children = {}
         for pid, parent, _, _ in processes:
             children.setdefault(parent, []).append(pid)
-        count, stack = 0, [self.process.pid]
+        found, stack = [], [self.process.pid]
         while stack:
             pid = stack.pop()
-            count += 1
+            found.append(pid)
             stack.extend(children.get(pid, ()))
-        return count
+        return found
+
+    def _tasks(self):
+        """How many threads the worker runs, over all its processes."""
+        return sum(_stat(pid)[0] for pid in self._pids())
+
+    def cpu_seconds(self):
+        """CPU seconds the worker's processes have used so far, their reaped children included."""
+        return sum(_stat(pid)[1] for pid in self._pids())
 
     def _stderr_tail(self):
-        self.stderr.seek(0)
-        text = self.stderr.read().decode("utf-8", "replace").strip().splitlines()
-        return "\n".join(text[-5:])
+        """The last lines the worker wrote to stderr; only the file's end is read."""
+        size = self.stderr.seek(0, os.SEEK_END)
+        self.stderr.seek(max(0, size - config.STDERR_TAIL_BYTES))
+        text = self.stderr.read(config.STDERR_TAIL_BYTES).decode("utf-8", "replace").strip().splitlines()
+        return "\n".join(line[:200] for line in text[-5:])
 
     # -- calls ------------------------------------------------------------------
 
     def call(self, module, function, args, kwargs):
         """Call ``pcl_course.<module>.<function>(*args, **kwargs)`` in the worker.
 
-        Arrays and random generators among the arguments that the call
-        modified in place are modified the same way here.
+        The arguments here are never changed: the worker works on its own
+        copies. Returns the answer; :attr:`last_modified` then holds the
+        paths of the arguments the call modified in place (``["args", 0]``
+        is the first positional one, ``["kwargs", "name"]`` a keyword one).
+        A random generator among the arguments draws on from where the call
+        left it.
         """
+        self.last_modified = []
         if module in self.broken:
-            raise SandboxError(self.broken[module])
+            raise SandboxError(self.broken[module], kind=IMPORT)
         if self.process is None or self.process.poll() is not None:
             self.stop()
             self.start()
         try:
             result = self._call(module, function, args, kwargs)
         except BaseException as exc:
-            if not getattr(exc, "from_submission", False) or self._stray_processes():
+            from_submission = getattr(exc, "from_submission", False)
+            stray = self._stray_tasks() if self.process is not None else False
+            if not from_submission or stray:
                 self.stop()  # a timed-out, broken or forking worker never serves another call
-            if self.process is None and getattr(exc, "from_submission", False):
-                raise SandboxError("the submission started processes of its own (a fork bomb?)") from None
+            if from_submission and stray:
+                raise SandboxError(STRAY_MESSAGE, kind=STRAY) from None
             raise
-        if self._stray_processes():
+        if self._stray_tasks():
             self.stop()
-            raise SandboxError("the submission started processes of its own (a fork bomb?)")
+            raise SandboxError(STRAY_MESSAGE, kind=STRAY)
         return result
 
-    def _stray_processes(self):
-        return self.process is not None and self._members() > self.baseline
+    def _stray_tasks(self):
+        return self.process is not None and self._tasks() > self.baseline
 
     def _call(self, module, function, args, kwargs):
         arguments = {"args": list(args), "kwargs": dict(kwargs)}
@@ -771,19 +887,19 @@ class Worker:
         request = pickle.dumps(
             {"module": module, "function": function, "args": args, "kwargs": kwargs, "read_only": read_only}
         )
-        deadline = time.monotonic() + self.timeout
+        deadline = _Deadline(self, self.timeout)
         try:
             self.process.stdin.write(struct.pack("<Q", len(request)) + request)
             self.process.stdin.flush()
         except BrokenPipeError:
-            raise SandboxError(self._death_message()) from None
+            raise SandboxError(self._death_message(), kind=DIED) from None
         try:
-            header = self._read_frame(deadline)
+            header = self._read_header(deadline)
         except SandboxError as exc:
             self.broken[module] = (
                 f"{module}.py cannot be imported: {exc}; every test of {module}.py fails until its import is fixed"
             )
-            raise SandboxError(self.broken[module]) from None
+            raise SandboxError(self.broken[module], kind=IMPORT) from None
         if not header.get("imported"):
             what = (
                 f"raised {header.get('type')}: {header.get('message')}"
@@ -795,53 +911,84 @@ class Worker:
                 f"{module}.py cannot be imported: it {what}{where}; every test of "
                 f"{module}.py fails until its import is fixed"
             )
-            raise SandboxError(self.broken[module])
-        answer = self._read_frame(deadline)
-        arrays = {}
-        if "npz" in answer:
-            data = self._read_frame(deadline, raw=True, expected=answer["npz"])
-            try:
-                with np.load(io.BytesIO(data), allow_pickle=False) as npz:
-                    arrays = {key: npz[key] for key in npz.files}
-            except Exception:
-                raise SandboxError("the worker's answer was garbled (unreadable arrays)") from None
-        _write_back(arguments, answer.get("modified", []), arrays)
-        if not answer.get("ok"):
+            raise SandboxError(self.broken[module], kind=IMPORT)
+        answer = self._read_header(deadline)
+        arrays = self._read_arrays(answer.get("arrays", []), deadline)
+        self.last_modified = _modified_paths(arguments, answer.get("modified", []))
+        if answer.get("ok") is not True:
+            if not isinstance(answer.get("type"), str):
+                raise SandboxError("the worker's answer was garbled", kind=GARBLED)
             exc = _exception(answer)
             exc.from_submission = True  # the function raised: the worker itself is fine
+            exc.modified = self.last_modified
             raise exc
-        return _decode(answer["value"], arrays)
+        return _decode(answer.get("value"), arrays)
+
+    # -- reading the worker's frames, every size checked before it is read ---------
+
+    def _wait_readable(self, deadline):
+        stream = self.process.stdout.fileno()
+        while True:
+            remaining = deadline.wall - time.monotonic()
+            if remaining <= 0:
+                raise SandboxError(
+                    f"timed out: the call waited for more than {deadline.wall_seconds:g} s (wall clock)", kind=TIMEOUT
+                )
+            ready, _, _ = select.select([stream], [], [], min(remaining, CPU_POLL_SECONDS))
+            if ready:
+                return stream
+            if self.cpu_seconds() - deadline.cpu_start > deadline.cpu_seconds:
+                raise SandboxError(
+                    f"timed out: the call used more than {deadline.cpu_seconds:g} s of CPU time", kind=TIMEOUT
+                )
 
     def _read_exactly(self, size, deadline):
-        stream = self.process.stdout.fileno()
-        while len(self.buffer) < size:
-            remaining = deadline - time.monotonic()
-            if remaining <= 0:
-                raise SandboxError(f"timed out: the call ran for more than {self.timeout:g} s")
-            ready, _, _ = select.select([stream], [], [], remaining)
-            if ready:
-                chunk = os.read(stream, 1 << 20)
-                if not chunk:
-                    raise SandboxError(self._death_message())
-                self.buffer += chunk
-        data, self.buffer = self.buffer[:size], self.buffer[size:]
-        return data
+        """``size`` bytes of the worker's stdout, into a buffer allocated once (``size`` is checked already)."""
+        buffer = bytearray(size)
+        view, got = memoryview(buffer), 0
+        while got < size:
+            stream = self._wait_readable(deadline)
+            count = os.readv(stream, [view[got:]])
+            if count == 0:
+                raise SandboxError(self._death_message(), kind=DIED)
+            got += count
+        return buffer
 
-    def _read_frame(self, deadline, raw=False, expected=None):
+    def _frame_size(self, deadline, limit):
         head = self._read_exactly(12, deadline)
         size = struct.unpack("<Q", head[4:])[0]
-        if head[:4] != MAGIC or size > config.ANSWER_LIMIT or (expected is not None and size != expected):
-            raise SandboxError("the worker's answer was garbled")
-        payload = self._read_exactly(size, deadline)
-        if raw:
-            return payload
+        if bytes(head[:4]) != MAGIC:
+            raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+        if size > limit:
+            raise SandboxError(_too_large(size, limit), kind=TOO_LARGE)
+        return size
+
+    def _read_header(self, deadline):
+        size = self._frame_size(deadline, config.HEADER_LIMIT)
         try:
-            header = json.loads(payload.decode("utf-8"))
-        except ValueError:
-            raise SandboxError("the worker's answer was garbled") from None
+            header = json.loads(self._read_exactly(size, deadline).decode("utf-8"))
+        except (ValueError, RecursionError):
+            raise SandboxError("the worker's answer was garbled", kind=GARBLED) from None
         if not isinstance(header, dict):
-            raise SandboxError("the worker's answer was garbled")
+            raise SandboxError("the worker's answer was garbled", kind=GARBLED)
         return header
+
+    def _read_arrays(self, declared, deadline):
+        """The arrays the answer's header declares: numeric dtypes only, all sizes checked first."""
+        if not isinstance(declared, list) or len(declared) > config.MAX_ARRAYS:
+            raise SandboxError("the worker's answer was garbled (too many arrays)", kind=GARBLED)
+        layouts = [_layout(entry) for entry in declared]
+        total = sum(dtype.itemsize * int(np.prod(shape, dtype=object)) for dtype, shape in layouts)
+        if total > config.ANSWER_LIMIT:
+            raise SandboxError(_too_large(total, config.ANSWER_LIMIT), kind=TOO_LARGE)
+        arrays = []
+        for dtype, shape in layouts:
+            nbytes = dtype.itemsize * int(np.prod(shape, dtype=object))
+            if self._frame_size(deadline, nbytes) != nbytes:
+                raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+            data = self._read_exactly(nbytes, deadline)
+            arrays.append(np.frombuffer(data, dtype=dtype).reshape(shape))
+        return arrays
 
     def _death_message(self):
         code = self.process.wait()
@@ -851,6 +998,87 @@ class Worker:
             hint = " (a resource limit: memory, CPU time, file size or processes)"
         tail = self._stderr_tail()
         return f"the submission's process died ({how}){hint}" + (f"; its last output:\n{tail}" if tail else "")
+
+
+CPU_POLL_SECONDS = 0.25  # how often a waiting call's CPU time is read
+STRAY_MESSAGE = "the submission left processes or threads running after the call returned"
+
+# The kinds of sandbox failure (SandboxError.kind): what a hidden test may say of one.
+TIMEOUT, DIED, GARBLED, TOO_LARGE = (
+    SandboxError.TIMEOUT,
+    SandboxError.DIED,
+    SandboxError.GARBLED,
+    SandboxError.TOO_LARGE,
+)
+UNSUPPORTED, IMPORT, STRAY = SandboxError.UNSUPPORTED, SandboxError.IMPORT, SandboxError.STRAY
+GENERATOR, RAISED = SandboxError.GENERATOR, SandboxError.RAISED
+
+
+@dataclass
+class _Deadline:
+    """A call's limits: CPU seconds of the worker from now, and a wall-clock backstop."""
+
+    worker: Worker
+    cpu_seconds: float
+
+    def __post_init__(self):
+        self.cpu_start = self.worker.cpu_seconds()
+        self.wall_seconds = self.cpu_seconds * config.CALL_WALL_FACTOR
+        self.wall = time.monotonic() + self.wall_seconds
+
+
+_CLOCK_TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+
+
+def _stat(pid):
+    """(threads, CPU seconds with reaped children) of a process, from /proc/PID/stat; (0, 0) once it is gone."""
+    try:
+        handle = os.open(f"/proc/{pid}/stat", os.O_RDONLY)
+        try:
+            text = os.read(handle, 4096)
+        finally:
+            os.close(handle)
+    except OSError:
+        return 0, 0.0
+    fields = text[text.rfind(b")") + 2 :].split()  # after the name, which may hold spaces
+    # fields[0] is field 3 (state): utime, stime, cutime, cstime are fields 14-17, num_threads 20
+    return int(fields[17]), sum(int(v) for v in fields[11:15]) / _CLOCK_TICKS
+
+
+def _too_large(size, limit):
+    return f"the answer is too large ({size / 2**20:.0f} MiB, at most {limit / 2**20:.0f} MiB)"
+
+
+_NUMERIC_DTYPE = re.compile(r"^[<>|=]?[biufc][1-9][0-9]?$")
+
+
+def _numeric_dtype(text):
+    """A plain numeric dtype from its ``dtype.str`` (no object, void, structured or string dtype), else None."""
+    if not isinstance(text, str) or not _NUMERIC_DTYPE.match(text):
+        return None
+    try:
+        dtype = np.dtype(text)
+    except TypeError:
+        return None
+    return dtype if dtype.kind in "biufc" and dtype.itemsize <= 16 else None
+
+
+def _layout(entry):
+    """(dtype, shape) of a declared array, checked: a numeric dtype and at most 32 non-negative extents."""
+    if isinstance(entry, dict):
+        dtype, shape = _numeric_dtype(entry.get("dtype")), entry.get("shape")
+        if (
+            dtype is not None
+            and isinstance(shape, list)
+            and len(shape) <= 32
+            and all(type(n) is int and 0 <= n < 2**62 for n in shape)
+        ):
+            return dtype, tuple(shape)
+        if dtype is None and isinstance(entry.get("dtype"), str):
+            raise SandboxError(
+                "returned an array of a dtype that is not numeric: return numeric numpy arrays", kind=UNSUPPORTED
+            )
+    raise SandboxError("the worker's answer was garbled", kind=GARBLED)
 
 
 def _arrays(value, path):
@@ -865,59 +1093,91 @@ def _arrays(value, path):
             yield from _arrays(item, [*path, key])
 
 
-def _write_back(arguments, modified, arrays):
-    """Apply to the grader's arguments what the call did to the worker's copies."""
-    if not isinstance(modified, list):
-        raise SandboxError("the worker's answer was garbled")
+def _modified_paths(arguments, modified):
+    """The paths of the arguments the call modified, as the worker names them; a random
+    generator takes the new state the worker sent (checked: one its own stream reaches)."""
+    if not isinstance(modified, list) or len(modified) > config.MAX_ARRAYS:
+        raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+    paths = []
     for change in modified:
         try:
             target = arguments
             for step in change["path"]:
                 target = target[step]
-            if isinstance(target, np.random.Generator):
-                target.bit_generator.state = change["state"]
-            elif type(target) is np.ndarray:
-                value = _decode(change["value"], arrays)
-                if (
-                    type(value) is np.ndarray
-                    and value.shape == target.shape
-                    and value.dtype == target.dtype
-                    and target.flags.writeable
-                ):
-                    target[...] = value
-        except (KeyError, IndexError, TypeError, ValueError):
-            raise SandboxError("the worker's answer was garbled") from None
+        except (KeyError, IndexError, TypeError):
+            raise SandboxError("the worker's answer was garbled", kind=GARBLED) from None
+        if isinstance(target, np.random.Generator):
+            set_generator_state(target, change.get("state"))
+        elif type(target) is not np.ndarray:
+            raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+        paths.append(list(change["path"]))
+    return paths
+
+
+def set_generator_state(generator, state):
+    """Give ``generator`` a state the worker sent back, if its own stream could reach it.
+
+    PCG64's state is a position on one stream (``inc``): any 128-bit
+    position on the same stream is one the generator reaches by drawing,
+    any other (another ``inc``, another bit generator, a malformed state)
+    is refused, so that no submission hands the grader a stream of its
+    choosing.
+    """
+    current = generator.bit_generator.state
+    ok = (
+        isinstance(state, dict)
+        and set(state) == set(current)
+        and state.get("bit_generator") == current["bit_generator"] in ("PCG64", "PCG64DXSM")
+        and isinstance(state.get("state"), dict)
+        and set(state["state"]) == {"state", "inc"}
+        and state["state"]["inc"] == current["state"]["inc"]
+        and type(state["state"]["state"]) is int
+        and 0 <= state["state"]["state"] < 2**128
+        and state.get("has_uint32") in (0, 1)
+        and type(state.get("uinteger")) is int
+        and 0 <= state["uinteger"] < 2**32
+    )
+    if not ok:
+        raise SandboxError(
+            "the random generator came back in a state its own stream cannot reach: draw from it, never set it",
+            kind=GENERATOR,
+        )
+    generator.bit_generator.state = state
 
 
 def _exception(answer):
-    kind = str(answer.get("type"))
-    message = str(answer.get("message"))
+    kind = str(answer.get("type"))[: config.MAX_TEXT]
+    message = str(answer.get("message"))[: config.MAX_TEXT]
     where = answer.get("where") if isinstance(answer.get("where"), str) else ""
+    where = where[: config.MAX_TEXT]
     shown = f" (at {where})" if where else ""
     cls = getattr(builtins, kind, None) if answer.get("builtin") is True else None
     if isinstance(cls, type) and issubclass(cls, Exception):
         try:
             exc = cls(message)
         except TypeError:  # a builtin whose constructor wants more (UnicodeDecodeError, ...)
-            return SandboxError(f"raised {kind}: {message}{shown}")
+            return SandboxError(f"raised {kind}: {message}{shown}", kind=RAISED)
         exc.where = where
         return exc
-    return SandboxError(f"raised {kind}: {message}{shown}")
+    return SandboxError(f"raised {kind}: {message}{shown}", kind=RAISED)
 
 
 def _decode(node, arrays):
     if not isinstance(node, dict):
-        raise SandboxError("the worker's answer was garbled")
+        raise SandboxError("the worker's answer was garbled", kind=GARBLED)
     kind = node.get("t")
     try:
         if kind == "ndarray":
-            return arrays[node["k"]]
-        if kind == "json":
+            if type(node["k"]) is int and 0 <= node["k"] < len(arrays):
+                return arrays[node["k"]]
+        elif kind == "json":
             value = node["v"]
             if value is None or type(value) in (bool, int, float, str):
                 return value
         elif kind == "npscalar":
-            return np.dtype(node["dtype"]).type(node["v"])
+            dtype = _numeric_dtype(node["dtype"])
+            if dtype is not None:
+                return dtype.type(node["v"])
         elif kind in ("tuple", "list"):
             items = [_decode(item, arrays) for item in node["items"]]
             return tuple(items) if kind == "tuple" else items
@@ -925,8 +1185,10 @@ def _decode(node, arrays):
             return {str(key): _decode(value, arrays) for key, value in node["items"].items()}
         elif kind == "unsupported":
             raise SandboxError(
-                f"returned {node.get('what')}: return plain numpy arrays, numbers, strings, tuples, lists or dicts"
+                f"returned {str(node.get('what'))[:200]}: return plain numpy arrays, numbers, strings, tuples, "
+                "lists or dicts",
+                kind=UNSUPPORTED,
             )
-    except (KeyError, TypeError, ValueError, AttributeError):
+    except (KeyError, TypeError, ValueError, AttributeError, OverflowError, RecursionError):
         pass
-    raise SandboxError("the worker's answer was garbled")
+    raise SandboxError("the worker's answer was garbled", kind=GARBLED)

@@ -4,17 +4,21 @@ It is a standalone script: it imports nothing from the grader, and in the
 bubblewrap sandbox it is the only file of the grader's that exists. It reads
 call requests from the grader (length-prefixed pickles written by the trusted
 grader only), imports the submission's module, runs the function and answers
-with frames of plain data on a private copy of the original stdout: a JSON
-header, then the result's arrays as ``.npz`` bytes that the grader loads
-with ``allow_pickle=False``. Nothing goes through a file, so the grader never
-opens a path the worker names. Whatever the submission prints goes to stderr.
+with frames on a private copy of the original stdout: a JSON header, then
+one raw frame per array the header declares (its dtype and shape). The
+grader checks every declared size against its caps before it reads a byte
+of it, and accepts numeric dtypes only: nothing the worker sends is
+unpickled, decompressed or parsed as anything but JSON and raw numbers.
+Nothing goes through a file, so the grader never opens a path the worker
+names. Whatever the submission prints goes to stderr.
 
 Each call is answered in two steps, so that the grader can tell a module
 that cannot be imported from a function that fails: first
 ``{"imported": true}`` (or the import's failure), then the call's answer.
-The answer also names every argument the call modified in place, with its
-new value, so that the grader can apply the same change to its own copy:
-a sandboxed call then behaves as an in-process one.
+The answer also names every argument the call modified in place (its path,
+no value): the grader's own arguments stay as they were before the call,
+and the modification is a verdict of its own. A random generator's new
+state is sent back, so that a later call draws on from it.
 
 Outside bubblewrap, before it imports anything of the submission's, the
 worker closes the network with a seccomp filter (:func:`close_network`):
@@ -32,7 +36,6 @@ namespace is the wall), or python -I -S worker.py --check-network SITE_PACKAGES.
 
 import errno
 import importlib
-import io
 import json
 import os
 import pickle
@@ -101,16 +104,15 @@ def _check_network(site_packages):
 def _encode(value, arrays, np):
     kind = type(value)
     if kind is np.ndarray:
-        if value.dtype.hasobject:
-            return {"t": "unsupported", "what": "an ndarray of Python objects"}
-        key = f"a{len(arrays)}"
-        arrays[key] = value
-        return {"t": "ndarray", "k": key}
+        if value.dtype.kind not in "biufc" or value.dtype.fields is not None:
+            return {"t": "unsupported", "what": f"an ndarray of dtype {value.dtype}"}
+        arrays.append(np.ascontiguousarray(value))
+        return {"t": "ndarray", "k": len(arrays) - 1}
     if isinstance(value, np.ndarray):
         return {"t": "unsupported", "what": f"a subclass of numpy.ndarray ({kind.__module__}.{kind.__qualname__})"}
     if kind in (bool, int, float, str) or value is None:
         return {"t": "json", "v": value}
-    if isinstance(value, np.generic) and kind.__module__ == "numpy" and not value.dtype.hasobject:
+    if isinstance(value, np.generic) and kind.__module__ == "numpy" and value.dtype.kind in "biufc":
         return {"t": "npscalar", "dtype": value.dtype.str, "v": value.item()}
     if kind in (tuple, list):
         return {"t": kind.__name__, "items": [_encode(v, arrays, np) for v in value]}
@@ -171,15 +173,16 @@ class _Protocol:
     def __init__(self, stream):
         self.stream = stream
 
-    def send(self, header, arrays=None, np=None):
-        if arrays:
-            buffer = io.BytesIO()
-            np.savez(buffer, allow_pickle=False, **arrays)
-            header["npz"] = buffer.tell()
-        payload = json.dumps(header, allow_nan=True).encode("utf-8")
+    def _frame(self, payload):
         self.stream.write(MAGIC + struct.pack("<Q", len(payload)) + payload)
+
+    def send(self, header, arrays=()):
+        """The header (JSON), then each array's raw bytes in its own frame."""
         if arrays:
-            self.stream.write(MAGIC + struct.pack("<Q", header["npz"]) + buffer.getvalue())
+            header["arrays"] = [{"dtype": a.dtype.str, "shape": list(a.shape)} for a in arrays]
+        self._frame(json.dumps(header, allow_nan=True).encode("utf-8"))
+        for array in arrays:
+            self._frame(array.tobytes())
         self.stream.flush()
 
 
@@ -202,19 +205,19 @@ def _call(request, protocol, np):
         if function is None:
             raise AttributeError(f"{request['module']}.py defines no function {request['function']}")
         result = function(*arguments["args"], **arguments["kwargs"])
-        arrays = {}
+        arrays = []
         answer = {"ok": True, "value": _encode(result, arrays, np)}
     except BaseException as exc:  # noqa: B902 -- KeyboardInterrupt and SystemExit are answers too
-        arrays, answer = {}, _failure(exc)
+        arrays, answer = [], _failure(exc)
     modified = []
     for path, value, before in watched:
         if _changed(value, before, np):
             if isinstance(value, np.random.Generator):
                 modified.append({"path": path, "state": value.bit_generator.state})
             else:
-                modified.append({"path": path, "value": _encode(value, arrays, np)})
+                modified.append({"path": path})
     answer["modified"] = modified
-    protocol.send(answer, arrays, np)
+    protocol.send(answer, arrays)
 
 
 def main():

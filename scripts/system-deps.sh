@@ -4,12 +4,15 @@
 #   chromium     : the browser the book's page tests drive (Playwright cannot
 #                  download its own browser here)
 #   bubblewrap   : the grader's sandbox (bwrap) for students' code
+#   acl          : setfacl, with which the grader (as root, without namespaces) bars
+#                  its sandbox uids from the forbidden packages (grading/sandbox.py)
 set -euo pipefail
 
 missing=()
 ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0' || missing+=(libusb-1.0-0)
 [ -x /usr/bin/chromium ] || missing+=(chromium)
 command -v bwrap >/dev/null 2>&1 || missing+=(bubblewrap)
+command -v setfacl >/dev/null 2>&1 || missing+=(acl)
 
 [ ${#missing[@]} -eq 0 ] && exit 0
 

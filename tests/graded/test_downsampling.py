@@ -9,7 +9,7 @@ statistically over fixed seeds.
 import numpy as np
 import pytest
 
-from grading.checks import check_array, check_close
+from grading.checks import check_array, check_close, raises
 
 
 def voxel_keys(xyz, size):
@@ -186,7 +186,7 @@ def test_voxel_grid_downsample_empty_cloud(impl):
 @pytest.mark.interface
 def test_voxel_grid_downsample_rejects_bad_input(impl, kwargs, name):
     arguments = {"points": np.random.default_rng(33).uniform(size=(10, 3)), "voxel_size": 0.5, **kwargs}
-    with pytest.raises(ValueError) as excinfo:
+    with raises(ValueError) as excinfo:
         impl.voxel_grid_downsample(**arguments)
     assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"
 
@@ -297,7 +297,7 @@ def test_approximate_voxel_downsample_rejects_bad_input(impl):
         ({"method": "mode"}, "method"),
     ):
         arguments = {"points": points, "voxel_size": 0.5, "n_containers": 10, **kwargs}
-        with pytest.raises(ValueError) as excinfo:
+        with raises(ValueError) as excinfo:
             impl.approximate_voxel_downsample(**arguments)
         assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"
 
@@ -431,7 +431,7 @@ def test_farthest_point_sampling_rejects_bad_arguments(impl, cloud):
         ({"start_index": 3000}, "start_index"),
     ):
         arguments = {"points": cloud, "n_samples": 5, **kwargs}
-        with pytest.raises(ValueError) as excinfo:
+        with raises(ValueError) as excinfo:
             impl.farthest_point_sampling(**arguments)
         assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"
 
@@ -526,6 +526,6 @@ def test_normal_space_sampling_rejects_bad_input(impl, skewed_normals):
         ({"normals": np.zeros((5, 2))}, "normals"),
     ):
         arguments = {"normals": skewed_normals, "n_samples": 10, **kwargs}
-        with pytest.raises(ValueError) as excinfo:
+        with raises(ValueError) as excinfo:
             impl.normal_space_sampling(**arguments)
         assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"

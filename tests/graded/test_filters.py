@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from scipy.spatial.distance import cdist
 
-from grading.checks import check_array, check_close
+from grading.checks import check_array, check_close, raises
 
 # --- radius_outlier_removal ------------------------------------------------------
 
@@ -68,7 +68,7 @@ def test_radius_outlier_removal_on_an_empty_cloud(impl):
 @pytest.mark.points(0.5)
 @pytest.mark.interface
 def test_radius_outlier_removal_rejects_a_bad_radius(impl):
-    with pytest.raises(ValueError) as excinfo:
+    with raises(ValueError) as excinfo:
         impl.radius_outlier_removal(np.zeros((3, 3)), 0.0, 2)
     assert "radius" in str(excinfo.value), f"the ValueError must name 'radius', got: {excinfo.value}"
 
@@ -195,7 +195,7 @@ def test_statistical_outlier_removal_keeps_an_evenly_spaced_cloud(impl):
 def test_statistical_outlier_removal_rejects_bad_k(impl):
     points = np.random.default_rng(54).normal(size=(10, 3))
     for bad in (0, 10):
-        with pytest.raises(ValueError) as excinfo:
+        with raises(ValueError) as excinfo:
             impl.statistical_outlier_removal(points, bad, 1.0)
         assert "k" in str(excinfo.value), f"the ValueError must name 'k', got: {excinfo.value}"
 

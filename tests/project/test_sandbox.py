@@ -355,7 +355,7 @@ def test_a_process_that_makes_itself_non_dumpable_is_still_seen_and_killed(tmp_p
     )
     worker = Worker(stage(package).root, timeout=20, level=Isolation(UID, uid, "test"))
     try:
-        with pytest.raises(SandboxError, match="processes of its own"):
+        with pytest.raises(SandboxError, match="left processes or threads running"):
             worker.call("evil", "hide", (), {})
     finally:
         worker.stop()

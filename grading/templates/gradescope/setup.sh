@@ -17,8 +17,9 @@ if [ "${PCL_SETUP_SKIP_APT:-0}" != 1 ]; then
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -qq
     # libusb-1.0-0: `import open3d` needs it; bubblewrap: the sandbox, where the
-    # container allows namespaces (otherwise a dedicated uid is the wall).
-    packages=(libusb-1.0-0 libgomp1 bubblewrap)
+    # container allows namespaces (otherwise a dedicated uid is the wall); acl:
+    # setfacl, which bars the sandbox uids from the forbidden packages in that mode.
+    packages=(libusb-1.0-0 libgomp1 bubblewrap acl)
     command -v "$PYTHON" >/dev/null 2>&1 || packages+=(python3.11 python3.11-venv)
     apt-get install -y -qq --no-install-recommends "${packages[@]}"
 fi

@@ -1,0 +1,104 @@
+"""Run the graded tests in their own pytest process (``python -m pytest`` with the grader's plugin).
+
+Used by ``python -m grading grade`` and ``batch`` (:mod:`grading.cli`) and by
+Gradescope's ``autograde`` (:mod:`grading.gradescope`).
+"""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+from grading import GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT
+
+PYTEST_EXIT_NO_TESTS = 5
+PYTEST_EXIT_USAGE = 4
+
+
+def run_graded_tests(
+    impl_dir,
+    results,
+    keyword=None,
+    junit=None,
+    overrides=(),
+    tests=None,
+    sandbox=False,
+    call_timeout=None,
+    require_isolation=False,
+    sandbox_uid=None,
+    functions=(),
+    budget=None,
+    note=None,
+    diagnose_always=False,
+):
+    """Run the graded tests on ``impl_dir`` in a pytest process; return its exit code and its output.
+
+    The paths that name a submission (its folder, its results file) and the
+    note on it go to pytest in a file only the grader's user can read, not
+    on its command line: any process, a submission graded beside this one
+    included, can read a command line in ``/proc``.
+    """
+    if tests is None:  # the public tests, and the hidden ones where they exist (not in a release)
+        tests = [d for d in (GRADED_TESTS, HIDDEN_TESTS) if d.is_dir()]
+    command = [
+        sys.executable,
+        "-m",
+        "pytest",
+        *[str(t) for t in (tests if isinstance(tests, list) else [tests])],
+        # The grader's own configuration only: nothing from the submission.
+        "-c",
+        str(REPO_ROOT / "grading" / "pytest.ini"),
+        "--rootdir",
+        str(REPO_ROOT),
+        "-p",
+        "pytest_timeout",
+        "-p",
+        "grading.plugin",
+        "-p",
+        "no:cacheprovider",
+        "-q",
+        "--tb=no",
+        "--no-header",
+        "-rN",
+    ]
+    for override in overrides:
+        command += ["--impl-module", override]
+    if sandbox:
+        command.append("--sandbox")
+    if require_isolation:
+        command.append("--require-isolation")
+    if sandbox_uid is not None:
+        command += ["--sandbox-uid", str(sandbox_uid)]
+    if call_timeout:
+        command += ["--call-timeout", str(call_timeout)]
+    if keyword:
+        command += ["-k", keyword]
+    for function in functions:
+        command += ["--function", function]
+    if budget is not None:
+        command += ["--budget", str(budget)]
+    if diagnose_always:
+        command.append("--diagnose-always")
+    if junit:
+        command += ["--junitxml", str(junit)]
+    # Only the plugins named above: the environment's others (nbval, dash,
+    # pytest-benchmark, xdist) have no say in a grade, and importing them costs 0.2 s a grade.
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
+    folder = tempfile.mkdtemp(prefix="grading-options-")  # mode 0700: the grader's user only
+    options_file = os.path.join(folder, "options.json")
+    try:
+        with open(os.open(options_file, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600), "w") as handle:
+            json.dump({"impl": str(impl_dir), "results": str(results), "submission_note": note}, handle)
+        completed = subprocess.run(
+            [*command, "--grading-options", options_file],
+            cwd=REPO_ROOT,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    return completed.returncode, completed.stdout
