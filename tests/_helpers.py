@@ -23,10 +23,20 @@ def run_grader(*args, tmp_path):
 
 
 def load_results(path):
-    """A results file, checked against Gradescope's format, with its total as ``max_score`` for the tests."""
+    """A results file, checked against Gradescope's format, for the tests: its total as
+    ``max_score``, each test's plain feedback as ``text``, and the whole grading as data
+    (``grading``, a :class:`grading.results.Grading`) under ``extra_data``'s fields."""
+    from grading.results import Grading, fenced
+
     results = json.loads(path.read_text())
     check_gradescope_results(results)
     results["max_score"] = sum(test["max_score"] for test in results["tests"])
+    grading = Grading.from_gradescope(results)
+    for test, result in zip(results["tests"], grading.tests):
+        test["text"] = result.output_text()
+        # The Markdown shows exactly the plain text, inside a fence that nothing in it can close.
+        assert test["output"] == (fenced(test["text"]) if test["text"] else ""), test
+    results["grading"] = grading
     return results
 
 

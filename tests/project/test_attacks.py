@@ -90,10 +90,10 @@ def test_a_symbolic_link_is_refused_with_one_line(tmp_path, target):
     assert time.monotonic() - started < 120
     assert summary["score"] == 0
     for test in summary["tests"]:
-        assert test["output"].startswith(
+        assert test["text"].startswith(
             "submission refused: pcl_course/metrics.py is a symbolic link: submit regular files only"
         ), test
-        assert "\n" not in test["output"]
+        assert "\n" not in test["text"]
     assert "Traceback" not in printed and "hunter" not in printed and "def chamfer_distance" not in printed
 
 
@@ -114,7 +114,7 @@ def test_other_files_that_are_not_plain_source_are_refused(tmp_path, kind):
         (package / "data.bin").write_bytes(b"0" * (64 * 1024**2))
     summary, printed = grade(clone, tmp_path, "-k", "test_chamfer_distance_")
     assert summary["score"] == 0
-    assert all(t["output"].startswith("submission refused: ") and "\n" not in t["output"] for t in summary["tests"])
+    assert all(t["text"].startswith("submission refused: ") and "\n" not in t["text"] for t in summary["tests"])
     assert "Traceback" not in printed
 
 
@@ -228,7 +228,7 @@ def test_a_submission_sees_nothing_but_itself(tmp_path, loopback_server, who):
         "test_chamfer_distance_hand_computed",
         as_user=UNPRIVILEGED_UID if who == "unprivileged" else None,
     )
-    output = summary["tests"][0]["output"]
+    output = summary["tests"][0]["text"]
     found = json.loads(output[output.index("SPY") + 3 : output.index("YPS")])
     assert found == {"readable": [], "writable": [], "processes": [], "forbidden": [], "network": False}
     assert not accepted
@@ -256,7 +256,7 @@ def test_the_grader_never_opens_a_path_the_worker_names(tmp_path):
     clone = make_submission(tmp_path / "clone", {"metrics.py": forger})
     summary, printed = grade(clone, tmp_path, "-k", "test_chamfer_distance_hand_computed")
     assert planted.exists()
-    assert summary["score"] == 0 and "garbled" in summary["tests"][0]["output"]
+    assert summary["score"] == 0 and "garbled" in summary["tests"][0]["text"]
     assert "Traceback" not in printed
 
 
@@ -271,7 +271,7 @@ def test_a_package_that_shadows_a_module_is_scanned(tmp_path):
     )
     summary, _ = grade(clone, tmp_path, "-k", "test_chamfer_distance_hand_computed")
     assert summary["score"] == 0
-    assert summary["tests"][0]["output"].startswith("forbidden API in metrics.py (core.py:2")
+    assert summary["tests"][0]["text"].startswith("forbidden API in metrics.py (core.py:2")
 
 
 # -- 3. a daemon left behind in batch -------------------------------------------------------------
@@ -320,7 +320,7 @@ def test_a_module_that_hangs_at_import_is_detected_once(tmp_path):
     elapsed = time.monotonic() - started
     tests = summary["tests"]
     assert len(tests) > 5 and all(t["score"] == 0 for t in tests)
-    messages = {t["output"].split("\n")[0].removesuffix(" (hidden test: details withheld)") for t in tests}
+    messages = {t["text"].split("\n")[0].removesuffix(" (hidden test: details withheld)") for t in tests}
     assert len({m[:60] for m in messages}) == 1, messages
     assert next(iter(messages)).startswith("metrics.py cannot be imported: timed out")
     assert elapsed < 60, f"{elapsed:.0f} s: the import hang was waited for more than once"

@@ -69,6 +69,6 @@ def test_a_forbidden_import_costs_the_whole_module_with_a_clear_message(tmp_path
         str(tmp_path / "clone"), "-k", "test_chamfer_distance_ or test_pca_", tmp_path=tmp_path
     )
     chamfer = [t for t in summary["tests"] if "chamfer" in t["name"]]
-    assert chamfer and all(t["score"] == 0 and "forbidden API in metrics.py" in t["output"] for t in chamfer)
-    assert "metrics.py:1: from sklearn.metrics import ..." in chamfer[0]["output"]
+    assert chamfer and all(t["score"] == 0 and "forbidden API in metrics.py" in t["text"] for t in chamfer)
+    assert "metrics.py:1: from sklearn.metrics import ..." in chamfer[0]["text"]
     assert "Traceback" not in stdout

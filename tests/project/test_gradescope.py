@@ -186,8 +186,8 @@ def test_a_hostile_submission_reads_writes_and_reaches_nothing(archive, tmp_path
     _make_reachable(root / "results")  # the folders above the mock /autograder: as open as / is
     results, printed = run_autograder(root, namespaces=namespaces)
     assert results["score"] == 0
-    outputs = [t["output"] for t in results["tests"] if t["tags"][0] == "chamfer_distance" and "SPY" in t["output"]]
-    assert outputs, [t["output"] for t in results["tests"] if t["tags"][0] == "chamfer_distance"]
+    outputs = [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance" and "SPY" in t["text"]]
+    assert outputs, [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance"]
     found = json.loads(outputs[0][outputs[0].index("SPY") + 3 : outputs[0].index("YPS")])
     assert found["readable"] == [] and found["writable"] == []
     # bubblewrap: the sandbox's own, empty loopback refuses; the uid level: seccomp refuses the socket.
@@ -229,5 +229,5 @@ def test_a_killed_run_leaves_valid_partial_results(archive, tmp_path):
     process.wait()
     results = load_results(results_file)
     assert len(passed) >= 3
-    assert any(t["output"].startswith("not run:") for t in results["tests"])
+    assert any(t["text"].startswith("not run:") for t in results["tests"])
     assert not [p for p in Path(results_file.parent).iterdir() if p.name != "results.json"]

@@ -23,8 +23,23 @@ def test_reference_gets_full_marks(reference_grading):
 
 def test_results_file_has_the_gradescope_format(tmp_path):
     summary, _ = grade("--reference", "-k", "test_pca_", tmp_path=tmp_path)
-    assert set(summary) == {"score", "max_score", "execution_time", "output", "stdout_visibility", "tests"}
-    assert summary["stdout_visibility"] == "hidden" and summary["output"] == "- `pca`: 25 / 25"
+    assert set(summary) - {"max_score", "grading"} == {
+        "score",
+        "execution_time",
+        "output",
+        "output_format",
+        "stdout_visibility",
+        "tests",
+        "extra_data",
+    }
+    assert summary["stdout_visibility"] == "hidden" and summary["output_format"] == "md"
+    public = sum(t["max_score"] for t in summary["tests"] if t["visibility"] == "visible")
+    hidden = summary["max_score"] - public
+    assert 0 < public < summary["max_score"]
+    assert summary["output"].startswith(
+        f"**Public tests: {public:g} / {public:g} points.** Hidden tests are worth {hidden:g}"
+    )
+    assert f"| `pca` | {public:g} / {public:g} |" in summary["output"]
     assert isinstance(summary["execution_time"], int)
     numbers = [test["number"] for test in summary["tests"]]
     assert numbers == [f"1.{i}" for i in range(1, len(numbers) + 1)]  # pca is the contract's first function
@@ -39,6 +54,8 @@ def test_results_file_has_the_gradescope_format(tmp_path):
             "output_format",
             "tags",
             "visibility",
+            "extra_data",
+            "text",
         }
         assert test["tags"] == ["pca"] and test["visibility"] in ("visible", "after_published")
         assert test["output_format"] == "md"
@@ -50,10 +67,12 @@ def test_stubs_get_zero_with_one_not_implemented_line_per_test(tmp_path):
     summary, stdout = grade(str(REPO_ROOT), tmp_path=tmp_path)
     assert summary["score"] == 0 and summary["max_score"] > 0
     for test in summary["tests"]:
-        assert test["output"].startswith("not implemented: "), test
-        assert "\n" not in test["output"], test
+        hidden = test["visibility"] == "after_published"
+        assert test["text"].startswith("not implemented (hidden test" if hidden else "not implemented: "), test
+        assert "\n" not in test["text"], test
     assert "Traceback" not in stdout
-    assert stdout.count("not implemented: ") == len(summary["tests"])
+    rows = [line for line in stdout.splitlines() if " FAIL " in line]
+    assert len(rows) == len(summary["tests"]) and all("not implemented" in row for row in rows)
 
 
 def test_every_graded_test_names_its_function(reference_grading):
@@ -165,13 +184,11 @@ def test_wrong_submission_loses_points_and_gets_its_diagnosis(mutant, tmp_path):
     function = mutant.parent.name
     found = summary.get("extra_data", {}).get("diagnoses", {}).get(function)
     assert found and found["id"] == expected, f"{mutant.relative_to(REPO_ROOT)}: diagnosed {found}, not {expected}"
-    # The line reaches the student: in the marks per function, and first in each explained test's feedback.
-    assert any(
-        line.startswith(f"- `{function}`:") and found["message"] in line for line in summary["output"].splitlines()
-    )
+    # The line reaches the student: in the summary of the public tests, and first in each explained test's feedback.
+    assert f"{function}: {found['message']}" in summary["output"]
     assert found["explains"] >= 1
     if found["id"] not in ONE_LINE_ALREADY:  # those tests say it in their own line already
-        explained = [t for t in summary["tests"] if t["output"].startswith(f"diagnosis: {found['message']}")]
+        explained = [t for t in summary["tests"] if t["text"].startswith(f"diagnosis: {found['message']}")]
         assert len(explained) == found["explains"]
 
 
@@ -208,10 +225,9 @@ def test_hidden_tests_run_when_grading_and_withhold_their_details(tmp_path):
     )
     hidden = [t for t in summary["tests"] if t["visibility"] == "after_published"]
     assert hidden and all(t["status"] == "failed" and "_hidden_" in t["name"] for t in hidden)
-    for test in hidden:  # one line, after the diagnosis (values-free) when there is one
-        lines = test["output"].splitlines()
-        assert lines[-1].endswith("(hidden test: details withheld)") and len(lines) <= 2, test["output"]
-        assert len(lines) == 1 or lines[0].startswith("diagnosis: "), test["output"]
+    for test in hidden:  # one line in the grader's words: no diagnosis, no text of the submission's
+        assert test["text"].endswith("(hidden test: details withheld)"), test["text"]
+        assert len(test["text"].splitlines()) == 1, test["text"]
 
 
 def test_junit_xml_is_written(tmp_path):
@@ -283,7 +299,7 @@ def test_tests_past_the_time_budget_score_zero_and_say_so(tmp_path):
     summary, _ = grade("--reference", "--function", "chamfer_distance", "--budget", "0", tmp_path=tmp_path)
     assert summary["tests"] and summary["score"] == 0
     for test in summary["tests"]:
-        assert test["output"] == "not run: the submission's time budget of 0 s ran out", test
+        assert test["text"] == "not run: the submission's time budget of 0 s ran out", test
 
 
 def test_a_killed_run_leaves_valid_partial_results(tmp_path):
@@ -329,6 +345,6 @@ def test_a_killed_run_leaves_valid_partial_results(tmp_path):
     summary = load_results(results)  # valid JSON: it was replaced atomically
     statuses = [t["status"] for t in summary["tests"]]
     assert "passed" in statuses
-    not_run = [t for t in summary["tests"] if t["output"] == "not run: grading stopped before this test"]
+    not_run = [t for t in summary["tests"] if t["text"] == "not run: grading stopped before this test"]
     assert not_run and all(t["score"] == 0 for t in not_run)
     assert summary["score"] == sum(t["score"] for t in summary["tests"])

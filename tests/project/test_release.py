@@ -142,8 +142,8 @@ def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
     assert completed.returncode == 0, completed.stdout + completed.stderr
     summary = load_results(release_dir / "r.json")
     assert summary["score"] == 0 and summary["max_score"] > 0
-    odd = [t for t in summary["tests"] if not t["output"].startswith("not implemented")]
-    assert not odd, [(t["name"], t["output"]) for t in odd[:3]]
+    odd = [t for t in summary["tests"] if not t["text"].startswith("not implemented")]
+    assert not odd, [(t["name"], t["text"]) for t in odd[:3]]
 
 
 def test_the_release_book_builds_with_the_stubs(release_dir):

@@ -121,14 +121,14 @@ def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     call also writes that input into the grader's arrays (the grader computes from a frozen copy)."""
     honest = grade(rewriting_submission(tmp_path / "honest", False), tmp_path / "honest.json")
     cheat = grade(rewriting_submission(tmp_path / "cheat", True), tmp_path / "cheat.json")
-    assert "isolated" in cheat["output"]
+    assert "isolated" in cheat["text"]
     honest_totals, cheat_totals = per_function(honest), per_function(cheat)
     assert set(cheat_totals) == set(GRADED_FUNCTIONS)
     raised = {f: (honest_totals[f], cheat_totals[f]) for f in GRADED_FUNCTIONS if cheat_totals[f] > honest_totals[f]}
     assert not raised, f"rewriting the input raised these scores (honest, rewriting): {raised}"
     # The rewrite itself is seen: the in-place tests fail on it, and only on it.
     in_place = {t["name"]: t for t in cheat["tests"] if "does_not_modify" in t["name"]}
-    assert in_place and all(t["score"] == 0 and "modified its input in place" in t["output"] for t in in_place.values())
+    assert in_place and all(t["score"] == 0 and "modified its input in place" in t["text"] for t in in_place.values())
     assert all(t["score"] == t["max_score"] for t in honest["tests"] if t["name"] in in_place)
     assert cheat["score"] < honest["score"] < honest["max_score"]
 
