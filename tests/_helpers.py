@@ -138,3 +138,16 @@ def check_gradescope_results(results):
         assert isinstance(test["number"], str)
     numbers = [t["number"] for t in results["tests"]]
     assert len(numbers) == len(set(numbers)), "test numbers must be unique"
+
+
+HIDDEN_REFUSAL = "the submission was refused (the public tests say why) (hidden test: details withheld)"
+
+
+def public_tests(summary):
+    """The tests a student sees at once (visibility ``visible``)."""
+    return [t for t in summary["tests"] if t["visibility"] == "visible"]
+
+
+def hidden_tests(summary):
+    """The tests shown after publication only; their feedback is in the grader's words."""
+    return [t for t in summary["tests"] if t["visibility"] != "visible"]

@@ -18,7 +18,15 @@ import threading
 import time
 
 import pytest
-from _helpers import load_results, run_batch, run_grader, write_reference_modules
+from _helpers import (
+    HIDDEN_REFUSAL,
+    hidden_tests,
+    load_results,
+    public_tests,
+    run_batch,
+    run_grader,
+    write_reference_modules,
+)
 
 from grading import REPO_ROOT
 from grading.sandbox import _make_reachable, isolation
@@ -89,11 +97,12 @@ def test_a_symbolic_link_is_refused_with_one_line(tmp_path, target):
     summary, printed = grade(clone, tmp_path, "-k", "test_chamfer_distance_")
     assert time.monotonic() - started < 120
     assert summary["score"] == 0
-    for test in summary["tests"]:
+    for test in public_tests(summary):
         assert test["text"].startswith(
             "submission refused: pcl_course/metrics.py is a symbolic link: submit regular files only"
         ), test
         assert "\n" not in test["text"]
+    assert all(t["text"] == HIDDEN_REFUSAL for t in hidden_tests(summary))
     assert "Traceback" not in printed and "hunter" not in printed and "def chamfer_distance" not in printed
 
 
@@ -114,7 +123,9 @@ def test_other_files_that_are_not_plain_source_are_refused(tmp_path, kind):
         (package / "data.bin").write_bytes(b"0" * (64 * 1024**2))
     summary, printed = grade(clone, tmp_path, "-k", "test_chamfer_distance_")
     assert summary["score"] == 0
-    assert all(t["text"].startswith("submission refused: ") and "\n" not in t["text"] for t in summary["tests"])
+    public = public_tests(summary)
+    assert all(t["text"].startswith("submission refused: ") and "\n" not in t["text"] for t in public)
+    assert all(t["text"] == HIDDEN_REFUSAL for t in hidden_tests(summary))
     assert "Traceback" not in printed
 
 
@@ -320,9 +331,11 @@ def test_a_module_that_hangs_at_import_is_detected_once(tmp_path):
     elapsed = time.monotonic() - started
     tests = summary["tests"]
     assert len(tests) > 5 and all(t["score"] == 0 for t in tests)
-    messages = {t["text"].split("\n")[0].removesuffix(" (hidden test: details withheld)") for t in tests}
+    messages = {t["text"].split("\n")[0] for t in public_tests(summary)}
     assert len({m[:60] for m in messages}) == 1, messages
     assert next(iter(messages)).startswith("metrics.py cannot be imported: timed out")
+    hidden = {t["text"] for t in hidden_tests(summary)}
+    assert hidden == {"the module could not be imported (hidden test: details withheld)"}, hidden
     assert elapsed < 60, f"{elapsed:.0f} s: the import hang was waited for more than once"
 
 

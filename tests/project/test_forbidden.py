@@ -68,7 +68,9 @@ def test_a_forbidden_import_costs_the_whole_module_with_a_clear_message(tmp_path
     summary, stdout = run_grader(
         str(tmp_path / "clone"), "-k", "test_chamfer_distance_ or test_pca_", tmp_path=tmp_path
     )
-    chamfer = [t for t in summary["tests"] if "chamfer" in t["name"]]
+    chamfer = [t for t in summary["tests"] if "chamfer" in t["name"] and t["visibility"] == "visible"]
     assert chamfer and all(t["score"] == 0 and "forbidden API in metrics.py" in t["text"] for t in chamfer)
+    hidden = [t for t in summary["tests"] if "chamfer" in t["name"] and t["visibility"] != "visible"]
+    assert hidden and all(t["score"] == 0 and "sklearn" not in t["text"] for t in hidden)
     assert "metrics.py:1: from sklearn.metrics import ..." in chamfer[0]["text"]
     assert "Traceback" not in stdout

@@ -27,7 +27,6 @@ from _helpers import load_results, reference_package, reference_source
 
 from grading import EXERCISE_MODULES, GRADED_FUNCTIONS, REPO_ROOT
 from grading.leakcheck import find_leaks
-from grading.plugin import points_per_function
 from grading.sandbox import _make_reachable
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="the dedicated-uid wall needs a root grader")
@@ -102,7 +101,7 @@ def test_the_reference_uploaded_as_a_repository_gets_full_marks(archive, tmp_pat
     hidden = [t for t in results["tests"] if t["visibility"] == "after_published"]
     assert hidden and all("hidden" in t["name"] for t in hidden)
     assert all(t["visibility"] == "visible" for t in results["tests"] if t not in hidden)
-    first, isolation = results["output"].splitlines()[:2]
+    first, isolation = results["grading"].note, results["grading"].isolation
     assert first == "Graded from my-repo/pcl_course/: " + ", ".join(f"`{m}.py`" for m in EXERCISE_MODULES) + "."
     assert isolation.startswith("isolated: bubblewrap")
     assert "Traceback" not in printed
@@ -114,7 +113,7 @@ def test_the_stubs_uploaded_as_the_package_folder_get_nothing(archive, tmp_path)
     results, _ = run_autograder(root)
     assert results["score"] == 0 and results["tests"]
     assert all(t["status"] == "failed" for t in results["tests"])
-    assert results["output"].startswith("Graded from pcl_course/: ")
+    assert results["grading"].note.startswith("Graded from pcl_course/: ")
 
 
 @needs_root
@@ -130,14 +129,14 @@ def test_a_wrong_module_uploaded_alone_is_graded_without_namespaces(archive, tmp
     (root / "submission" / "helpers.py").write_text("SCALE = 1.0\n")
     (root / "submission" / "notes.txt").write_text("my notes")
     results, _ = run_autograder(root, namespaces=False)
-    lines = results["output"].splitlines()
+    lines = [results["grading"].note, results["grading"].isolation]
     assert lines[0] == (
         "Graded from the uploaded files: `pca.py`. Missing (graded as the course's stub, 0 points): "
         + ", ".join(f"`{m}.py`" for m in EXERCISE_MODULES if m != "pca")
         + ". Not graded (not exercise modules): `helpers.py`."
     )
     assert lines[1].startswith("isolated: dedicated uid") and "seccomp" in lines[1]
-    totals = points_per_function(results["tests"])
+    totals = results["grading"].per_function()
     assert 0 < totals["pca"][0] < totals["pca"][1]  # the N - 1 covariance loses some of pca's points
     assert totals["kernel_matrix"][0] == totals["kernel_matrix"][1]  # pca.py's other functions are right
     assert totals["fit_plane"][0] == 0
@@ -203,15 +202,15 @@ def test_an_upload_without_code_or_with_a_link_gets_one_line(archive, tmp_path):
     (root / "submission" / "README.md").write_text("I forgot my code")
     results, _ = run_autograder(root)
     assert results["score"] == 0 and results["tests"] == []
-    assert results["output"].startswith("submission refused: no pcl_course/ folder and none of pca.py")
+    assert results["grading"].note.startswith("submission refused: no pcl_course/ folder and none of pca.py")
     (root / "submission" / "pca.py").symlink_to(root / "source" / "course" / "pcl_course" / "pca.py")
     results, _ = run_autograder(root)
-    assert results["output"] == "submission refused: pca.py is a symbolic link: submit regular files only"
+    assert results["grading"].note == "submission refused: pca.py is a symbolic link: submit regular files only"
     (root / "submission" / "pca.py").unlink()
     for name in ("a", "b"):
         (root / "submission" / name / "pcl_course").mkdir(parents=True)
     results, _ = run_autograder(root)
-    assert "several pcl_course/ folders (a/pcl_course, b/pcl_course)" in results["output"]
+    assert "several pcl_course/ folders (a/pcl_course, b/pcl_course)" in results["grading"].note
 
 
 def test_a_killed_run_leaves_valid_partial_results(archive, tmp_path):

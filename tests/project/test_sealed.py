@@ -133,7 +133,7 @@ def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     assert cheat["score"] < honest["score"] < honest["max_score"]
 
 
-GENERATORS = '''
+GENERATORS = """
 import numpy as np
 
 def advance(rng):
@@ -150,7 +150,7 @@ def fixed_point(rng):
     state["state"] = {"state": 0, "inc": 0}  # s -> a * 0 + 0: every draw 0, and integers() never returns
     rng.bit_generator.state = state
     return 0
-'''
+"""
 
 
 def test_a_generator_comes_back_only_on_its_own_stream(tmp_path):
@@ -176,7 +176,7 @@ def test_a_generator_comes_back_only_on_its_own_stream(tmp_path):
 
 # Each function writes one hostile answer straight to the protocol's pipe (the worker's
 # private copy of its stdout, the first descriptor after stderr), then waits to be killed.
-FRAMES = '''
+FRAMES = """
 import json, os, struct, sys, time, zlib, io, zipfile
 MAGIC = b"PCLW"
 OUT = 3
@@ -248,7 +248,7 @@ def stderr_flood(*args):  # 96 MiB of lines on stderr, then a crash
 def largest_answer(*args):  # the largest answer the grader accepts, whole
     import numpy as np
     return np.zeros((CAP - 1024) // 8)
-'''.replace("CAP", str(config.ANSWER_LIMIT))
+""".replace("CAP", str(config.ANSWER_LIMIT))
 
 PAYLOADS = (
     "huge_header",
@@ -312,7 +312,7 @@ def test_the_graders_memory_stays_bounded_whatever_a_worker_sends(tmp_path):
 # -- the worker's process: root, threads, time ------------------------------------------------------
 
 
-ROOT_WRITES = '''
+ROOT_WRITES = """
 import os
 
 def fill(path):
@@ -325,7 +325,7 @@ def fill(path):
     except OSError as exc:
         return f"{type(exc).__name__} after {written} MiB: {exc.strerror}"
     return f"wrote {written} MiB"
-'''
+"""
 
 
 @needs_bubblewrap
@@ -340,7 +340,7 @@ def test_the_bubblewrap_root_is_read_only_and_tmp_is_the_only_writable_place(tmp
         worker.close()
 
 
-THREADS = '''
+THREADS = """
 import threading, time
 
 def spin():
@@ -358,7 +358,7 @@ def sleep_in_thread():
 
 def echo(x):
     return x
-'''
+"""
 
 
 def test_a_thread_left_running_fails_its_call_like_a_process(tmp_path):
@@ -374,7 +374,7 @@ def test_a_thread_left_running_fails_its_call_like_a_process(tmp_path):
         worker.close()
 
 
-BURN = '''
+BURN = """
 import time
 
 def burn(seconds):
@@ -386,7 +386,7 @@ def burn(seconds):
 def sleep(seconds):
     time.sleep(seconds)
     return seconds
-'''
+"""
 
 
 def _hog():
