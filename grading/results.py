@@ -96,6 +96,8 @@ class TestResult:
     a hidden test's feedback names the broken rule only.
     """
 
+    __test__ = False  # a result, not a test class for pytest to collect
+
     name: str
     number: str
     function: str

@@ -230,3 +230,61 @@ def test_a_killed_run_leaves_valid_partial_results(archive, tmp_path):
     assert len(passed) >= 3
     assert any(t["text"].startswith("not run:") for t in results["tests"])
     assert not [p for p in Path(results_file.parent).iterdir() if p.name != "results.json"]
+
+
+LEFTOVERS = """
+import json, os, sys
+
+
+def chamfer_distance(a, b):
+    found = {"package": None, "command_lines": [], "left": []}
+    # Around the import blocker, by a name the static scan cannot read.
+    sys.meta_path[:] = [f for f in sys.meta_path if type(f).__name__ != "_ForbiddenImports"]
+    name = bytes([115, 107, 108, 101, 97, 114, 110]).decode()
+    try:
+        sys.modules["importlib"].import_module(name + ".decomposition")
+        found["package"] = "imported"
+    except BaseException as exc:
+        found["package"] = type(exc).__name__
+    # Every command line this uid can read: none may name where the submission or its results are.
+    for pid in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as handle:
+                line = handle.read().replace(b"\\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if "gradescope-submission-" in line or "results.json" in line or "--impl " in line:
+            found["command_lines"].append(line[:300])
+    # Something for the next submission to find.
+    for folder in ("/tmp", "/var/tmp", "/dev/shm"):
+        path = os.path.join(folder, "pcl-token-%(token)s")
+        try:
+            with open(path, "w") as handle:
+                handle.write("token")
+            os.chmod(path, 0o644)
+            found["left"].append(path)
+        except OSError:
+            pass
+    raise RuntimeError("SPY" + json.dumps(found) + "YPS")
+"""
+
+
+@needs_root
+@pytest.mark.parametrize("namespaces", [True, False], ids=["bubblewrap", "uid"])
+def test_the_sandbox_uid_reaches_no_forbidden_package_no_path_and_leaves_nothing(archive, tmp_path, namespaces):
+    """The uid mode (no namespaces) as tight as bubblewrap: the forbidden packages are barred to the
+    sandbox uids, no command line names the submission, and what the uid wrote is gone after grading."""
+    root = autograder_root(archive, tmp_path / "autograder")
+    token = f"{os.getpid()}-{time.monotonic_ns()}"
+    (root / "submission" / "metrics.py").write_text(LEFTOVERS % {"token": token})
+    results, _ = run_autograder(root, namespaces=namespaces)
+    outputs = [t["text"] for t in results["tests"] if "SPY" in t["text"]]
+    assert outputs, [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance"]
+    found = json.loads(outputs[0][outputs[0].index("SPY") + 3 : outputs[0].index("YPS")])
+    assert found["package"] in ("ModuleNotFoundError", "ImportError", "PermissionError"), found
+    assert found["command_lines"] == [], found
+    assert found["left"], "the submission could write nowhere: the check above proves nothing"
+    left = [f"{folder}/pcl-token-{token}" for folder in ("/tmp", "/var/tmp", "/dev/shm")]
+    assert not [path for path in left if os.path.lexists(path)]
+    isolation = results["grading"].isolation
+    assert isolation.startswith("isolated: bubblewrap" if namespaces else "isolated: dedicated uid"), isolation
