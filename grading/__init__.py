@@ -1,6 +1,9 @@
 """The course autograder.
 
 * :mod:`grading.cli` -- ``python -m grading grade | batch | release | gradescope | autograde | similarity``.
+* :mod:`grading.runner` -- the pytest process that runs the graded tests.
+* :mod:`grading.results` -- the results as data (:class:`~grading.results.Grading`),
+  written to Gradescope's JSON and the terminal table, every submission text sanitised.
 * :mod:`grading.plugin` -- pytest plugin: the ``impl`` fixture that hands the
   implementation under test to graded tests, points per test, per-test
   timeouts, short feedback and the results file.

@@ -282,7 +282,7 @@ def main(argv=None):
     g.add_argument(
         "--call-timeout",
         type=float,
-        help=f"seconds one call of a submission may take (default {config.CALL_TIMEOUT:g})",
+        help=f"CPU seconds one call of a submission may take (default {config.CALL_TIMEOUT:g})",
     )
     g.add_argument(
         "--require-isolation",

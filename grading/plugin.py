@@ -81,7 +81,8 @@ def pytest_addoption(parser):
         type=float,
         default=grading_config.CALL_TIMEOUT,
         metavar="SECONDS",
-        help=f"wall-clock limit of one call in the sandbox (default {grading_config.CALL_TIMEOUT:g})",
+        help=f"CPU seconds of one call in the sandbox (default {grading_config.CALL_TIMEOUT:g}; "
+        f"{grading_config.CALL_WALL_FACTOR:g} times as many seconds of wall clock stop a call that waits)",
     )
     group.addoption(
         "--sandbox-uid",

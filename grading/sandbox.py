@@ -12,17 +12,21 @@ machine allows (:func:`isolation`):
     interpreter (``sys.base_prefix``), the system libraries, the
     environment's site-packages with every forbidden package and every
     editable-install file masked, the staged submission and the worker
-    script; a size-capped tmpfs for ``/tmp`` (also ``HOME``); its own
-    ``/proc`` and a minimal ``/dev``. No repository, ``.git``, tests,
-    solutions, ``grading/`` or other submission exists there.
+    script; a size-capped tmpfs for ``/tmp`` (also ``HOME``), the only
+    writable place (the root is remounted read-only); its own ``/proc`` and
+    a minimal ``/dev``. No repository, ``.git``, tests, solutions,
+    ``grading/`` or other submission exists there.
 ``uid``
     No namespaces (a container that forbids them), but the grader is root:
     the worker runs as a dedicated unprivileged uid (one per ``batch`` slot)
-    and the grader first checks, as that uid, that the course's tests,
-    solutions and ``.git`` cannot be read, and that a seccomp filter closes
-    the network (``grading/worker.py``'s ``close_network``; the worker
-    refuses to run without it). Everything that uid left running is killed
-    after each worker.
+    and the grader bars every sandbox uid from the forbidden packages with a
+    POSIX ACL (:func:`bar_sandbox_uids`), then checks, as that uid, that
+    the course's tests, solutions and ``.git`` and those packages cannot be
+    read, and that a seccomp filter closes the network
+    (``grading/worker.py``'s ``close_network``; the worker refuses to run
+    without it). Everything that uid left running is killed after each
+    worker, and every file it owns in the world-writable folders is removed
+    before and after each submission (:func:`remove_files_of`).
 ``none``
     Neither: the worker runs as the grader's own user, with the resource
     limits only. Grading still runs, but the result is a local check, not a
@@ -30,13 +34,17 @@ machine allows (:func:`isolation`):
 
 At every level the worker runs under ``RLIMIT_AS``, ``RLIMIT_CPU``,
 ``RLIMIT_FSIZE`` and, as its own user, ``RLIMIT_NPROC``, and answers with
-plain data only, over its stdout: JSON plus ``.npz`` bytes read with
-``allow_pickle=False``. The grader never opens a path the worker names and
-never unpickles what the worker sent.
+plain data only, over its stdout: a JSON header, then raw numeric arrays
+whose dtype and shape the header declares, every size checked against
+:mod:`grading.config`'s caps before anything is allocated. The grader never
+opens a path the worker names, and never unpickles or decompresses what the
+worker sent. A call is limited by the worker's CPU time (every process and
+thread of it), with a wall-clock backstop, so that the machine's load
+changes no mark.
 
-A call that times out, crashes the worker or returns something that is not
-plain data fails that call (and so that test); the next call starts a fresh
-worker. A module that cannot be imported (it raises, exits, crashes or hangs
+A call that times out, crashes the worker, leaves a thread or a process
+running, or returns something that is not plain data fails that call (and
+so that test); the next call starts a fresh worker. A module that cannot be imported (it raises, exits, crashes or hangs
 at import) is detected once: every later call into it fails at once with
 the same message.
 """

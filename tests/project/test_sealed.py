@@ -121,7 +121,7 @@ def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     call also writes that input into the grader's arrays (the grader computes from a frozen copy)."""
     honest = grade(rewriting_submission(tmp_path / "honest", False), tmp_path / "honest.json")
     cheat = grade(rewriting_submission(tmp_path / "cheat", True), tmp_path / "cheat.json")
-    assert "isolated" in cheat["text"]
+    assert cheat["grading"].isolation.startswith("isolated")
     honest_totals, cheat_totals = per_function(honest), per_function(cheat)
     assert set(cheat_totals) == set(GRADED_FUNCTIONS)
     raised = {f: (honest_totals[f], cheat_totals[f]) for f in GRADED_FUNCTIONS if cheat_totals[f] > honest_totals[f]}
