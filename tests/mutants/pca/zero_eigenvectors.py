@@ -1,9 +1,9 @@
-"""Right eigenvalues, all-zero eigenvectors: H @ 0 == 0 * lambda satisfies the eigen-equation."""
+"""Right eigenvalues, all-zero eigenvectors: the eigen-equation H @ 0 = 0 * lambda holds, orthonormality does not."""
 
 import numpy as np
 
 from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
-from solutions.pca import pca as _reference  # noqa: F401
+from solutions.pca import pca as _reference
 
 MISTAKE = "zero_eigenvectors"  # the diagnosis this mistake must get (grading/mistakes/)
 
