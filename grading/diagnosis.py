@@ -165,7 +165,7 @@ def _explicit(function, calls, outcomes, failed, context):
     if kinds <= {REFUSED, SANDBOX} and len({c.error for c in calls}) <= 1 and all(c.raised for c in calls):
         # Refused at staging, or a module that cannot be imported: each test already says it in one line.
         errors = {c.error for c in calls}
-        why = errors.pop().removeprefix("raised SandboxError: ") if errors else "the submission was refused"
+        why = errors.pop() if errors else "the submission was refused"
         return Diagnosis("sandbox", f"every test failed the same way: {why}", failed)
     if kinds == {FORBIDDEN}:
         return Diagnosis(

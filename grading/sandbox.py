@@ -839,12 +839,14 @@ class Worker:
         return found
 
     def _tasks(self):
-        """How many threads the worker runs, over all its processes."""
-        return sum(_stat(pid)[0] for pid in self._pids())
+        """How many threads the worker runs, over all its processes (remembered for :meth:`cpu_seconds`)."""
+        self.known_pids = self._pids()
+        return sum(_stat(pid)[0] for pid in self.known_pids)
 
-    def cpu_seconds(self):
-        """CPU seconds the worker's processes have used so far, their reaped children included."""
-        return sum(_stat(pid)[1] for pid in self._pids())
+    def cpu_seconds(self, pids=None):
+        """CPU seconds the worker's processes (``pids``, else all found now) have used so far,
+        their reaped children included."""
+        return sum(_stat(pid)[1] for pid in (self._pids() if pids is None else pids))
 
     def _stderr_tail(self):
         """The last lines the worker wrote to stderr; only the file's end is read."""
@@ -1030,7 +1032,9 @@ class _Deadline:
     cpu_seconds: float
 
     def __post_init__(self):
-        self.cpu_start = self.worker.cpu_seconds()
+        # Between calls the worker runs exactly the processes counted after the last one (any more
+        # would have stopped it): no need to walk /proc again here, the hot path of every call.
+        self.cpu_start = self.worker.cpu_seconds(getattr(self.worker, "known_pids", None))
         self.wall_seconds = self.cpu_seconds * config.CALL_WALL_FACTOR
         self.wall = time.monotonic() + self.wall_seconds
 
