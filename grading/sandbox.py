@@ -889,7 +889,21 @@ class Worker:
         return result
 
     def _stray_tasks(self):
-        return self.process is not None and self._tasks() > self.baseline
+        """Whether the worker runs more threads or processes than when it started.
+
+        A thread that was joined before the call returned may still be
+        leaving the kernel's task list (``Thread.join`` returns just before
+        the thread's last instructions, and a busy machine may not schedule
+        them at once): only what outlives a grace period is stray.
+        """
+        if self.process is None:
+            return False
+        deadline = time.monotonic() + STRAY_GRACE_SECONDS
+        while self._tasks() > self.baseline:
+            if time.monotonic() > deadline:
+                return True
+            time.sleep(0.005)
+        return False
 
     def _call(self, module, function, args, kwargs):
         arguments = {"args": list(args), "kwargs": dict(kwargs)}
@@ -1011,6 +1025,7 @@ class Worker:
 
 
 CPU_POLL_SECONDS = 0.25  # how often a waiting call's CPU time is read
+STRAY_GRACE_SECONDS = 2.0  # how long a thread or process past the call's end may take to finish exiting
 STRAY_MESSAGE = "the submission left processes or threads running after the call returned"
 
 # The kinds of sandbox failure (SandboxError.kind): what a hidden test may say of one.

@@ -253,8 +253,8 @@ def chamfer_distance(a, b):
                 line = handle.read().replace(b"\\0", b" ").decode(errors="replace")
         except OSError:
             continue
-        if "gradescope-submission-" in line or "results.json" in line or "--impl " in line:
-            found["command_lines"].append(line[:300])
+        if "gradescope-submission-" in line or %(results)r in line:  # where its code and its results are
+            found["command_lines"].append(line[:60])
     # Something for the next submission to find.
     for folder in ("/tmp", "/var/tmp", "/dev/shm"):
         path = os.path.join(folder, "pcl-token-%(token)s")
@@ -276,7 +276,7 @@ def test_the_sandbox_uid_reaches_no_forbidden_package_no_path_and_leaves_nothing
     sandbox uids, no command line names the submission, and what the uid wrote is gone after grading."""
     root = autograder_root(archive, tmp_path / "autograder")
     token = f"{os.getpid()}-{time.monotonic_ns()}"
-    (root / "submission" / "metrics.py").write_text(LEFTOVERS % {"token": token})
+    (root / "submission" / "metrics.py").write_text(LEFTOVERS % {"token": token, "results": str(root / "results")})
     results, _ = run_autograder(root, namespaces=namespaces)
     outputs = [t["text"] for t in results["tests"] if "SPY" in t["text"]]
     assert outputs, [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance"]
