@@ -40,7 +40,7 @@ lint: setup
 	$(BIN)/ruff format --check .
 
 test: lint book notebooks
-	$(BIN)/python -m pytest -n auto
+	$(BIN)/python -m pytest -n auto --durations=20
 	$(BIN)/python -m pytest -n auto --dist loadfile --nbval-lax _build/notebooks
 
 grade: setup
