@@ -61,7 +61,9 @@ TMP_SIZE = 256 * 1024**2  # bytes of the worker's private /tmp (tmpfs, bubblewra
 ANSWER_LIMIT = 128 * 1024**2  # bytes of all the arrays of one answer
 HEADER_LIMIT = 1024**2  # bytes of one answer's JSON header
 MAX_ARRAYS = 4096  # arrays (and modified arguments) in one answer
-MAX_TEXT = 2000  # characters kept of an exception's type, message or place
+MAX_TEXT = 2000  # characters kept of any one text a submission produced (a message, a name, a place)
+MAX_OUTPUT = 4000  # characters of one test's feedback (grading/results.py)
+MAX_OUTPUT_LINES = MAX_FEEDBACK_LINES + 2  # lines of it: the message's, a diagnosis and the last call
 STDERR_TAIL_BYTES = 64 * 1024  # of the worker's stderr, read from its end after a crash
 
 # The dedicated, unprivileged uids that run submissions when the grader is

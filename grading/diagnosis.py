@@ -108,15 +108,6 @@ def snapshot(args, kwargs):
         return None
 
 
-def changed(before, after):
-    """Whether any array argument differs from its copy taken before the call."""
-    for old, new in zip(before, after):
-        if isinstance(old, np.ndarray) and isinstance(new, np.ndarray):
-            if old.shape != new.shape or not np.array_equal(old, new, equal_nan=old.dtype.kind in "fc"):
-                return True
-    return False
-
-
 # -- the contract's signatures -------------------------------------------------------
 
 

@@ -30,11 +30,7 @@ import re
 import unicodedata
 from dataclasses import dataclass, field
 
-from grading.config import GRADED_FUNCTIONS
-
-MAX_TEXT = 2000  # characters of one cleaned text (a message, a file name, a diagnosis)
-MAX_OUTPUT = 4000  # characters of one test's feedback
-MAX_LINES = 14  # lines of one test's feedback
+from grading.config import GRADED_FUNCTIONS, MAX_OUTPUT, MAX_OUTPUT_LINES, MAX_TEXT
 
 NOT_RUN = "not run: grading stopped before this test"
 HIDDEN_NOTE = "(hidden test: details withheld)"
@@ -79,7 +75,7 @@ def fenced(text, info="text"):
     return f"{fence}{info}\n{text}\n{fence}"
 
 
-def cap_lines(text, lines=MAX_LINES, limit=MAX_OUTPUT):
+def cap_lines(text, lines=MAX_OUTPUT_LINES, limit=MAX_OUTPUT):
     """At most ``lines`` lines and ``limit`` characters of ``text``, saying what was cut."""
     kept = text.splitlines()
     if len(kept) > lines:

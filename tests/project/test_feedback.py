@@ -12,15 +12,14 @@ import json
 import os
 import re
 import shutil
-import subprocess
-import sys
 import textwrap
 
 import pytest
-from _helpers import hidden_tests, load_results, public_tests
+from _helpers import hidden_tests, public_tests, run_grader
 
 from grading import REPO_ROOT
-from grading.results import MAX_OUTPUT, Grading, TestResult, clean, fenced
+from grading.config import MAX_OUTPUT
+from grading.results import Grading, TestResult, clean, fenced
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="needs root (the uid mode)")
 
@@ -33,16 +32,9 @@ def submission(root, metrics_source):
 
 
 def grade(clone, tmp_path, *args):
-    results = tmp_path / "results.json"
-    completed = subprocess.run(
-        [sys.executable, "-m", "grading", "grade", str(clone), "--results", str(results), *args],
-        cwd=REPO_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert completed.returncode == 0, completed.stdout + completed.stderr
-    return load_results(results), completed.stdout, results.read_text()
+    """(results, what the grader printed, the results file's raw text)."""
+    summary, printed = run_grader(str(clone), *args, tmp_path=tmp_path)
+    return summary, printed, (tmp_path / "results.json").read_text()
 
 
 HOSTILE_TEXT = """

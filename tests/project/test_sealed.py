@@ -20,7 +20,7 @@ import time
 
 import numpy as np
 import pytest
-from _helpers import load_results, reference_package
+from _helpers import reference_package, run_grader
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
 from grading.errors import SandboxError
@@ -122,19 +122,6 @@ def honest_overrides(folder):
     return overrides
 
 
-def grade(submission, results, *args, env=None):
-    completed = subprocess.run(
-        [sys.executable, "-m", "grading", "grade", str(submission), "--results", str(results), *args],
-        cwd=REPO_ROOT,
-        capture_output=True,
-        text=True,
-        timeout=900,
-        env=env,
-    )
-    assert completed.returncode == 0, completed.stdout + completed.stderr
-    return load_results(results)
-
-
 def per_function(results):
     totals = {}
     for test in results["tests"]:
@@ -145,8 +132,8 @@ def per_function(results):
 def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     """For every graded function: answers computed on a rewritten input score no more when the
     call also writes that input into the grader's arrays (the grader computes from a frozen copy)."""
-    honest = grade("--reference", tmp_path / "honest.json", *honest_overrides(tmp_path / "honest"))
-    cheat = grade(rewriting_submission(tmp_path / "cheat", True), tmp_path / "cheat.json")
+    honest, _ = run_grader("--reference", *honest_overrides(tmp_path / "honest"), tmp_path=tmp_path / "honest")
+    cheat, _ = run_grader(str(rewriting_submission(tmp_path / "cheat", True)), tmp_path=tmp_path / "cheat")
     assert cheat["grading"].isolation.startswith("isolated")
     honest_totals, cheat_totals = per_function(honest), per_function(cheat)
     assert set(cheat_totals) == set(GRADED_FUNCTIONS)
