@@ -58,7 +58,7 @@ FILE_SIZE_LIMIT = 256 * 1024**2  # bytes of any one file the worker writes
 TMP_SIZE = 256 * 1024**2  # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
 # What the grader reads from a worker, every size checked before anything is allocated
 # (grading/sandbox.py): the grader's own memory stays bounded whatever a worker sends.
-ANSWER_LIMIT = 128 * 1024**2  # bytes of all the arrays of one answer
+ANSWER_LIMIT = 16 * 1024**2  # bytes of all the arrays of one answer (the reference's largest: 95 kB)
 HEADER_LIMIT = 1024**2  # bytes of one answer's JSON header
 MAX_ARRAYS = 4096  # arrays (and modified arguments) in one answer
 MAX_TEXT = 2000  # characters kept of any one text a submission produced (a message, a name, a place)

@@ -1073,7 +1073,7 @@ def _stat(pid):
 
 
 def _too_large(size, limit):
-    return f"the answer is too large ({size / 2**20:.0f} MiB, at most {limit / 2**20:.0f} MiB)"
+    return f"the answer is too large ({size / 2**20:.2f} MiB, at most {limit / 2**20:.2f} MiB)"
 
 
 _NUMERIC_DTYPE = re.compile(r"^[<>|=]?[biufc][1-9][0-9]?$")

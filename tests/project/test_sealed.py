@@ -13,6 +13,7 @@ Feedback, the oracle of hidden tests and the uid mode are in
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import textwrap
@@ -20,7 +21,7 @@ import time
 
 import numpy as np
 import pytest
-from _helpers import reference_package, run_grader
+from _helpers import load_results, reference_package, run_grader
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
 from grading.errors import SandboxError
@@ -323,6 +324,53 @@ def test_the_graders_memory_stays_bounded_whatever_a_worker_sends(tmp_path):
     assert outcomes["largest_answer"].startswith("returned ndarray")
     # The cap is one answer's arrays; the grader's modules take the rest.
     assert measured["peak_mib"] < 500, measured
+
+
+LARGEST = """
+import numpy as np
+
+
+def chamfer_distance(a, b):  # the largest answer the grader accepts, at every call
+    return np.zeros(CAP // 8)
+
+
+def depth_metrics(predicted, target, mask=None):
+    return {"rmse": np.zeros(CAP // 8)}
+""".replace("CAP", str(config.ANSWER_LIMIT))
+
+PEAK_PLUGIN = """
+def pytest_unconfigure(config):
+    with open(PEAK, "w") as handle:
+        handle.write(next(line for line in open("/proc/self/status") if line.startswith("VmHWM:")))
+"""
+
+
+def test_a_whole_grading_with_the_largest_answers_stays_under_500_mib(tmp_path):
+    """The grading process itself (pytest, the plugin, the graded tests' own imports and their
+    checks on the answers), every call of two functions answering the largest accepted array."""
+    clone = tmp_path / "clone"
+    shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
+    (clone / "pcl_course" / "metrics.py").write_text(LARGEST)
+    peak = tmp_path / "peak.txt"
+    (tmp_path / "peak_plugin.py").write_text(PEAK_PLUGIN.replace("PEAK", repr(str(peak))))
+    options = tmp_path / "options.json"
+    results = tmp_path / "results.json"
+    options.write_text(json.dumps({"impl": str(clone / "pcl_course"), "results": str(results)}))
+    command = [
+        sys.executable, "-m", "pytest", str(REPO_ROOT / "tests" / "graded"), str(REPO_ROOT / "tests" / "hidden"),
+        "-c", str(REPO_ROOT / "grading" / "pytest.ini"), "--rootdir", str(REPO_ROOT),
+        "-p", "pytest_timeout", "-p", "grading.plugin", "-p", "peak_plugin", "-p", "no:cacheprovider",
+        "-q", "--tb=no", "--sandbox", "--grading-options", str(options),
+        "--function", "chamfer_distance", "--function", "depth_metrics", "--function", "estimate_normals",
+    ]  # fmt: skip
+    env = dict(os.environ, PYTHONPATH=str(tmp_path), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
+    subprocess.run(command, cwd=REPO_ROOT, env=env, capture_output=True, timeout=600)
+    summary = load_results(results)
+    metrics = [t for t in summary["tests"] if t["tags"][0] in ("chamfer_distance", "depth_metrics")]
+    assert metrics and all(t["score"] == 0 for t in metrics)  # graded, not refused: the answers got through
+    assert not any("too large" in t["text"] for t in metrics)
+    peak_mib = int(peak.read_text().split()[1]) / 1024
+    assert peak_mib < 500, f"the grading process peaked at {peak_mib:.0f} MiB"
 
 
 # -- the worker's process: root, threads, time ------------------------------------------------------
