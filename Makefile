@@ -3,6 +3,7 @@
 #   make test     set up, lint, build the book, run the whole test suite
 #   make lint     ruff check and ruff format --check (rules in pyproject.toml)
 #   make grade SUBMISSION=dir    grade a student's clone
+#   make requirements   re-pin requirements/ (the lock and its two subsets)
 #   make bench    time the references against Open3D, scikit-learn and fpsample
 #   make gradescope   write the Gradescope autograder archive (GRADESCOPE_ZIP)
 SUBMISSION ?=
@@ -66,11 +67,19 @@ bench: setup
 	    --benchmark-sort=name $(BENCH_ARGS)
 	$(BIN)/python -m benchmarks.report _build/bench/raw.json $(BENCH_OUT)
 
-# Re-pin requirements.txt from requirements.in in a throw-away environment.
+# Re-pin the lock, requirements/course.txt, from requirements/course.in, then
+# its two subsets, grading.txt and student.txt, with the lock as constraints.
+# uv resolves for every platform at once (--universal) and for the oldest
+# supported Python, whatever runs it; the existing pins are kept where they
+# still resolve. README "Environments".
+UV_VERSION   := 0.13.9
+PYTHON_FLOOR := 3.11.0
+UV_COMPILE    = build/uv/bin/uv pip compile --quiet --universal --python-version $(PYTHON_FLOOR) \
+                --custom-compile-command "make requirements"
 requirements:
-	rm -rf build/req-venv && $(PYTHON) -m venv build/req-venv
-	build/req-venv/bin/pip install --quiet -r requirements.in
-	build/req-venv/bin/pip freeze --exclude-editable > requirements.txt
+	test -x build/uv/bin/uv || { $(PYTHON) -m venv build/uv && build/uv/bin/pip install --quiet uv==$(UV_VERSION); }
+	cd requirements && ../$(UV_COMPILE) course.in -o course.txt
+	cd requirements && for env in grading student; do ../$(UV_COMPILE) $$env.in -c course.txt -o $$env.txt || exit 1; done
 
 clean:
 	rm -rf _build results build

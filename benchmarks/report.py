@@ -14,7 +14,7 @@ import json
 import platform
 import sys
 from collections import defaultdict
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 
@@ -103,7 +103,7 @@ def summarise(raw):
             case["target"] = {"peer": peer, "limit": limit, "ratio": ratios[peer], "met": ratios[peer] <= limit}
         cases.append(case)
     return {
-        "generated": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "generated": datetime.now(UTC).isoformat(timespec="seconds"),
         "command": "make bench",
         "machine": machine(raw),
         "cases": cases,

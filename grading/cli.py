@@ -33,6 +33,7 @@ error (no ``pcl_course/`` found, no test selected); 1 if pytest itself broke.
 
 import argparse
 import csv
+import importlib.util
 import json
 import os
 import queue
@@ -256,6 +257,14 @@ def similarity(args):
     return 0
 
 
+INSTRUCTOR_COMMANDS = {
+    "release": "grading.release",
+    "gradescope": "grading.gradescope",
+    "similarity": "grading.similarity",
+    "autograde": "grading.gradescope",
+}
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m grading", description=__doc__.split("\n")[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -342,6 +351,10 @@ def main(argv=None):
     a.add_argument("--root", default="/autograder", help="the autograder folder (default /autograder)")
     a.add_argument("--budget", type=float, metavar="SECONDS", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    module = INSTRUCTOR_COMMANDS.get(args.command)
+    if module and importlib.util.find_spec(module) is None:
+        print(f"error: `{args.command}` is an instructors' command, not in the student repository", file=sys.stderr)
+        return 2
     if args.command == "similarity":
         return similarity(args)
     if args.command == "gradescope":

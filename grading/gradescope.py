@@ -35,15 +35,22 @@ from pathlib import Path
 from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
 from grading.leakcheck import find_leaks
-from grading.release import IGNORED, _substitute
 from grading.results import Grading, clean
 from grading.runner import run_graded_tests
+from grading.shipping import IGNORED, cut_reference_link
 from grading.staging import read_regular_file, stage
 
 TEMPLATES = Path(__file__).with_name("templates") / "gradescope"
 COURSE = "course"  # the course copy's folder inside /autograder/source
 # What the grader needs, from this repository; solutions/ never.
-COURSE_FILES = ("pcl_course", "grading", "tests/graded", "tests/hidden", "requirements.txt")
+COURSE_FILES = (
+    "pcl_course",
+    "grading",
+    "tests/graded",
+    "tests/hidden",
+    "requirements/grading.txt",
+    "scripts/check_python.py",
+)
 SCRIPTS = ("setup.sh", "run_autograder")
 ZIP_DATE = (2026, 1, 1, 0, 0, 0)  # every entry's time: the same course gives the same archive
 
@@ -65,12 +72,7 @@ def _course_copy(into):
         else:
             target.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(source, target)
-    book_helper = into / "pcl_course" / "book.py"  # the book's link to the reference: cut, as in the release
-    book_helper.write_text(
-        _substitute(
-            book_helper.read_text(), 'REFERENCE_PACKAGE = "solutions"', "REFERENCE_PACKAGE = None", "pcl_course/book.py"
-        )
-    )
+    cut_reference_link(into / "pcl_course")  # as in the release
 
 
 def _zip_entry(name):

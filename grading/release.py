@@ -1,14 +1,18 @@
 """``python -m grading release OUT_DIR``: write the student repository.
 
 What goes out: the stubs and helpers of ``pcl_course/``, the book sources
-with every ``{solution}`` block removed, the public graded tests, the grader
-(so that students see the same marks table), the set-up files, a student
-README and a GitHub Actions workflow (the advisory check). What stays: ``solutions/``, the
-project's own tests, the wrong and alternative submissions, and any hidden
-tests. The release is then scanned for the reference's code
-(:mod:`grading.leakcheck`); a match fails the release.
+with every instructor-only ``{solution}`` block removed, the public graded
+tests, the grader's runtime (so that students see the same marks table), the
+student's set-up files and pins (``requirements/student.txt`` for the book,
+``requirements/grading.txt`` for the workflow), a student README and a GitHub
+Actions workflow (the advisory check). What stays: ``solutions/``, the
+project's own tests, the wrong and alternative submissions, any hidden tests,
+CI, and the instructors' tools (:data:`grading.shipping.INSTRUCTOR_ONLY_GRADER`).
+The release is then scanned for the reference's code (:mod:`grading.leakcheck`);
+a match fails the release.
 """
 
+import hashlib
 import re
 import shutil
 from pathlib import Path
@@ -17,41 +21,27 @@ import yaml
 
 from grading import REPO_ROOT
 from grading.leakcheck import find_leaks
+from grading.shipping import IGNORED, INSTRUCTOR_ONLY_GRADER, cut_reference_link, substitute
 
 COPIED = [
     "pcl_course",
     "grading",
     "tests/graded",
     "book",
-    "scripts",
+    "scripts/setup.mk",
+    "scripts/system-deps.sh",
+    "scripts/check_python.py",
     "_toc.yml",
-    "requirements.txt",
-    "requirements.in",
+    "requirements/student.txt",
+    "requirements/grading.txt",
     ".gitignore",
-    ".ci/run",
-    "benchmarks/results",
-]  # the appendix reads the results, not the harness
-IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".ipynb_checkpoints")
-# The catalogue of known mistakes computes right answers: it stays with the instructors.
-WITHHELD = ("grading/mistakes",)
+    "benchmarks/results",  # the appendix reads the results, not the harness
+]
 
 TEMPLATES = Path(__file__).with_name("templates")  # the student repository's own files
-
-
-def _substitute(text, old, new, where, regex=False):
-    """Replace ``old`` by ``new`` in ``text``, which must hold it exactly once.
-
-    A release never silently ships an unchanged file because its source
-    text moved on: a pattern found zero or several times stops the release.
-    """
-    if regex:
-        text, count = re.subn(old, new, text, flags=re.M)
-    else:
-        count = text.count(old)
-        text = text.replace(old, new)
-    if count != 1:
-        raise SystemExit(f"error: the release expects {old!r} exactly once in {where}, found it {count} times")
-    return text
+# The files whose hashes the workflow checks before it trusts this repository's grader.
+GRADER_FILES = ("grading", "tests/graded", "pyproject.toml")
+GRADER_MANIFEST = ".github/grader.sha256"
 
 
 INSTRUCTOR_ONLY = "instructor-only"  # the class that keeps a {solution} out of the student release
@@ -76,27 +66,30 @@ def _strip_solutions(markdown):
 
 def _student_config(text):
     # Cells of exercises a student has not done yet show "not implemented" instead of failing the build.
-    text = _substitute(text, "  allow_errors: false", "  allow_errors: true", "_config.yml")
-    return _substitute(
+    text = substitute(text, "  allow_errors: false", "  allow_errors: true", "_config.yml")
+    return substitute(
         text, "    nb_execution_raise_on_error: true", "    nb_execution_raise_on_error: false", "_config.yml"
     )
 
 
 def _student_pyproject(text):
     # The student package and the grader only: no reference, no benchmark harness.
-    text = _substitute(
+    text = substitute(
         text, r"^packages = \[[^\]]*\]", 'packages = ["pcl_course", "grading"]', "pyproject.toml", regex=True
     )
-    return _substitute(text, r"^testpaths = \[[^\]]*\]", 'testpaths = ["tests/graded"]', "pyproject.toml", regex=True)
+    return substitute(text, r"^testpaths = \[[^\]]*\]", 'testpaths = ["tests/graded"]', "pyproject.toml", regex=True)
 
 
 WORKFLOW_HEADER = """\
 # The advisory check: on every push, the public tests grade this repository's
-# pcl_course/ with a PRISTINE copy of the course's grader (not this
-# repository's grading/ or tests/), in its bubblewrap sandbox, and the marks
-# table goes to the run's summary. You control this repository, so this mark
-# is advisory: the official mark is the instructor's (Gradescope, or their
-# re-grade of your submission).
+# pcl_course/ with a pristine grader, in its bubblewrap sandbox, and the marks
+# table goes to the run's summary. The grader is either the course
+# repository's (COURSE_REPOSITORY below, or the repository variable
+# PCL_COURSE_REPOSITORY; a private one needs a read token in the secret
+# PCL_COURSE_TOKEN), or, when none is named, this repository's own copy,
+# used only if its files match the release's hashes (.github/grader.sha256).
+# You control this repository, so this mark is advisory: the official mark
+# is the instructor's (Gradescope, or their re-grade of your submission).
 """
 
 
@@ -109,45 +102,78 @@ _WorkflowDumper.add_representer(
     lambda dumper, text: dumper.represent_scalar("tag:yaml.org,2002:str", text, style="|" if "\n" in text else None),
 )
 
+ACTIONS = {"checkout": "actions/checkout@v6", "setup-python": "actions/setup-python@v6"}
 
-SETUP_COMMANDS = [
-    "sudo apt-get update",
-    "sudo apt-get install -y --no-install-recommends libusb-1.0-0 bubblewrap",
-    "# Ubuntu 24.04 lets AppArmor forbid unprivileged user namespaces; bubblewrap needs them.",
-    "sudo sysctl -w kernel.apparmor_restrict_unprivileged_userns=0 || true",
-    "python -m pip install --quiet -r course/requirements.txt",
-    "python -m pip install --quiet --no-deps -e course",
-    "mkdir -p results",
-]
+CHOOSE_GRADER = """\
+if [ -n "$COURSE_REPOSITORY" ]; then
+  echo "source=course" >> "$GITHUB_OUTPUT"
+  echo "Grading with the course repository $COURSE_REPOSITORY's grader"
+else
+  echo "source=hashes" >> "$GITHUB_OUTPUT"
+  echo "No course repository named: grading with this repository's grader, if it matches the release's hashes"
+fi"""
+
+CHECK_HASHES = f"""\
+# Every grader file listed, no file added, every hash equal.
+find {" ".join(GRADER_FILES)} -type f ! -path '*/__pycache__/*' ! -name '*.pyc' | sort > /tmp/present
+awk '{{print $2}}' {GRADER_MANIFEST} | sort > /tmp/released
+if ! diff /tmp/released /tmp/present || ! sha256sum --check --strict --quiet {GRADER_MANIFEST}; then
+  echo "::error::this repository's grader (grading/, tests/graded/, pyproject.toml) differs from the release:" \\
+       "restore those files from the first commit, or name the course repository"
+  exit 1
+fi
+mkdir -p ../course && cp -a --parents {" ".join(GRADER_FILES)} pcl_course requirements scripts ../course/"""
+
+SET_UP = """\
+sudo apt-get update -qq
+sudo apt-get install -y -qq --no-install-recommends bubblewrap
+# Ubuntu 24.04 lets AppArmor forbid unprivileged user namespaces; bubblewrap needs them.
+sudo sysctl -w kernel.apparmor_restrict_unprivileged_userns=0 || true
+python -m pip install --quiet -r course/requirements/grading.txt
+python -m pip install --quiet --no-deps -e course
+mkdir -p results"""
+
+GRADE = """\
+set -o pipefail
+python -m grading grade ../submission --require-isolation --results ../results/results.json \\
+  | tee ../results/marks.txt"""
+
+SUMMARY = """\
+{
+  echo '## Advisory marks (public tests)'
+  echo
+  if [ -s results/marks.txt ] && [ "$GRADE" = success ]; then
+    echo "The official mark is the instructor's re-grade (or Gradescope). Grader: $GRADER."
+    echo
+    echo '```'
+    cat results/marks.txt
+    echo '```'
+  elif [ "$COURSE" = failure ]; then
+    echo "Grading did not run: the course repository $COURSE_REPOSITORY could not be checked out." \\
+         "If it is private, the instructor adds a read-only token as the secret PCL_COURSE_TOKEN."
+  elif [ "$HASHES" = failure ]; then
+    echo "Grading did not run: this repository's grader (grading/, tests/graded/, pyproject.toml)" \\
+         "differs from the release. Restore those files."
+  elif [ "$SETUP" != success ]; then
+    echo "Grading did not run: the set-up step failed ($SETUP); see its log."
+  else
+    echo "Grading failed ($GRADE); see the grading step's log."
+  fi
+} >> "$GITHUB_STEP_SUMMARY"
+"""
 
 
 def _student_workflow(course_repository):
     """A plain GitHub Actions workflow (no GitHub Classroom): the advisory check.
 
-    ``course_repository`` is the instructor's student repository
-    (``OWNER/NAME``) whose grader and public tests are checked out pristine;
-    ``None`` reads it from the repository variable ``PCL_COURSE_REPOSITORY``.
+    ``course_repository`` (``OWNER/NAME``) is the instructor's student
+    repository whose grader and public tests are checked out pristine;
+    ``None`` reads it from the repository variable ``PCL_COURSE_REPOSITORY``,
+    and when that is empty too, the workflow grades with this repository's
+    own grader only if it matches :data:`GRADER_MANIFEST`, and says so.
     """
     repository = course_repository or "${{ vars.PCL_COURSE_REPOSITORY }}"
-    grade = " ".join(
-        [
-            "python -m grading grade ../submission --require-isolation --results ../results/results.json",
-            "| tee ../results/marks.txt",
-        ]
-    )
-    summary = "\n".join(
-        [
-            "{",
-            "  echo '## Advisory marks (public tests)'",
-            "  echo",
-            "  echo 'The official mark is the instructor'\\''s re-grade (or Gradescope).'",
-            "  echo",
-            "  echo '```'",
-            "  cat ../results/marks.txt",
-            "  echo '```'",
-            '} >> "$GITHUB_STEP_SUMMARY"',
-        ]
-    )
+    source = "steps.grader.outputs.source"
     workflow = {
         "name": "Advisory check",
         "on": {"push": None, "workflow_dispatch": None},
@@ -156,42 +182,75 @@ def _student_workflow(course_repository):
             "check": {
                 "runs-on": "ubuntu-24.04",
                 "timeout-minutes": 30,
+                "env": {"COURSE_REPOSITORY": repository},
                 "steps": [
                     {
                         "name": "Check out this repository (the submission)",
-                        "uses": "actions/checkout@v4",
+                        "uses": ACTIONS["checkout"],
                         "with": {"path": "submission"},
                     },
+                    {"name": "Choose the grader", "id": "grader", "run": CHOOSE_GRADER},
                     {
                         "name": "Check out the pristine course (its grader and public tests)",
-                        "uses": "actions/checkout@v4",
+                        "id": "course",
+                        "if": f"{source} == 'course'",
+                        "uses": ACTIONS["checkout"],
                         "with": {
-                            "repository": repository,
+                            "repository": "${{ env.COURSE_REPOSITORY }}",
                             "ref": "${{ vars.PCL_COURSE_REF || 'main' }}",
+                            "token": "${{ secrets.PCL_COURSE_TOKEN || github.token }}",
                             "path": "course",
                         },
                     },
-                    {"uses": "actions/setup-python@v5", "with": {"python-version": "3.11"}},
                     {
-                        "name": "Set up (Debian packages, pinned requirements, the sandbox)",
-                        "run": "\n".join(SETUP_COMMANDS),
+                        "name": "Or check this repository's grader against the release's hashes",
+                        "id": "hashes",
+                        "if": f"{source} == 'hashes'",
+                        "working-directory": "submission",
+                        "run": CHECK_HASHES,
                     },
+                    {
+                        "uses": ACTIONS["setup-python"],
+                        "with": {
+                            "python-version": "3.11",
+                            "cache": "pip",
+                            "cache-dependency-path": "course/requirements/grading.txt",
+                        },
+                    },
+                    {"name": "Set up (bubblewrap, the lean grading environment)", "id": "setup", "run": SET_UP},
                     {
                         "name": "Grade with the pristine grader (advisory)",
+                        "id": "grade",
                         "working-directory": "course",
-                        "run": f"set -o pipefail\n{grade}",
+                        "run": GRADE,
                     },
                     {
-                        "name": "Write the marks to the summary",
+                        "name": "Write the marks, or why there are none, to the summary",
                         "if": "always()",
-                        "working-directory": "course",
-                        "run": summary,
+                        "env": {
+                            "GRADER": f"${{{{ {source} == 'course' && env.COURSE_REPOSITORY "
+                            "|| 'this repository''s copy, identical to the release' }}",
+                            "COURSE": "${{ steps.course.outcome }}",
+                            "HASHES": "${{ steps.hashes.outcome }}",
+                            "SETUP": "${{ steps.setup.outcome }}",
+                            "GRADE": "${{ steps.grade.outcome }}",
+                        },
+                        "run": SUMMARY,
                     },
                 ],
             }
         },
     }
     return WORKFLOW_HEADER + yaml.dump(workflow, Dumper=_WorkflowDumper, sort_keys=False, width=120)
+
+
+def _grader_manifest(out):
+    """``sha256sum`` lines of every file of :data:`GRADER_FILES` in the release."""
+    files = []
+    for name in GRADER_FILES:
+        path = out / name
+        files += sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    return "".join(f"{hashlib.sha256(p.read_bytes()).hexdigest()}  {p.relative_to(out).as_posix()}\n" for p in files)
 
 
 def release(out_dir, course_repository=None):
@@ -206,22 +265,20 @@ def release(out_dir, course_repository=None):
     out.mkdir(parents=True, exist_ok=True)
     for name in COPIED:
         source = REPO_ROOT / name
+        (out / name).parent.mkdir(parents=True, exist_ok=True)
         if source.is_dir():
             shutil.copytree(source, out / name, ignore=IGNORED)
-            for withheld in WITHHELD:
-                if withheld.startswith(f"{name}/"):
-                    shutil.rmtree(out / withheld, ignore_errors=True)
-        elif source.exists():
-            (out / name).parent.mkdir(parents=True, exist_ok=True)
+        else:
             shutil.copy2(source, out / name)
+    for withheld in INSTRUCTOR_ONLY_GRADER:
+        path = out / withheld
+        if path.is_dir():
+            shutil.rmtree(path)
+        else:
+            path.unlink(missing_ok=True)
     for page in (out / "book").glob("*.md"):
         page.write_text(_strip_solutions(page.read_text()))
-    book_helper = out / "pcl_course" / "book.py"
-    book_helper.write_text(
-        _substitute(
-            book_helper.read_text(), 'REFERENCE_PACKAGE = "solutions"', "REFERENCE_PACKAGE = None", "pcl_course/book.py"
-        )
-    )
+    cut_reference_link(out / "pcl_course")
     (out / "_config.yml").write_text(_student_config((REPO_ROOT / "_config.yml").read_text()))
     (out / "pyproject.toml").write_text(_student_pyproject((REPO_ROOT / "pyproject.toml").read_text()))
     for name in ("Makefile", "README.md"):
@@ -229,4 +286,5 @@ def release(out_dir, course_repository=None):
     workflow = out / ".github" / "workflows" / "check.yml"
     workflow.parent.mkdir(parents=True)
     workflow.write_text(_student_workflow(course_repository))
+    (out / GRADER_MANIFEST).write_text(_grader_manifest(out))
     return find_leaks(out)

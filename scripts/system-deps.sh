@@ -1,18 +1,54 @@
 #!/usr/bin/env bash
-# Install the Debian packages the course needs, or say exactly how to.
-#   libusb-1.0-0 : `import open3d` fails without libusb-1.0.so.0
-#   chromium     : the browser the book's page tests drive (Playwright cannot
-#                  download its own browser here)
-#   bubblewrap   : the grader's sandbox (bwrap) for students' code
-#   acl          : setfacl, with which the grader (as root, without namespaces) bars
-#                  its sandbox uids from the forbidden packages (grading/sandbox.py)
+# Install the system packages the course needs, or say exactly how to.
+#   scripts/system-deps.sh [grading] [book] [browser]
+#     grading : bubblewrap, the grader's sandbox (bwrap) for students' code; acl
+#               (setfacl), with which the grader, as root without namespaces, bars
+#               its sandbox uids from the forbidden packages (grading/sandbox.py)
+#     book    : the shared libraries Open3D's wheel links against (libusb, libGL,
+#               libEGL, libX11, libgomp): without them `import open3d` fails
+#     browser : Chromium, which the book's page tests drive (instructors only)
+# A package is missing when its library or command is: the check is by file,
+# so another distribution's package that provides it counts too.
 set -euo pipefail
 
+groups=("$@")
+[ ${#groups[@]} -gt 0 ] || groups=(grading book browser)
+distribution=$(. /etc/os-release 2>/dev/null && echo "${ID:-unknown}" || echo unknown)
+
+has_library() { ldconfig -p 2>/dev/null | grep -q "$1"; }
 missing=()
-ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0' || missing+=(libusb-1.0-0)
-[ -x /usr/bin/chromium ] || missing+=(chromium)
-command -v bwrap >/dev/null 2>&1 || missing+=(bubblewrap)
-command -v setfacl >/dev/null 2>&1 || missing+=(acl)
+advice=()
+for group in "${groups[@]}"; do
+    case "$group" in
+    grading)
+        command -v bwrap >/dev/null 2>&1 || missing+=(bubblewrap)
+        command -v setfacl >/dev/null 2>&1 || missing+=(acl)
+        has_library 'libseccomp.so.2' || missing+=(libseccomp2)
+        ;;
+    book)
+        has_library 'libusb-1.0.so.0' || missing+=(libusb-1.0-0)
+        has_library 'libGL.so.1' || missing+=(libgl1)
+        has_library 'libEGL.so.1' || missing+=(libegl1)
+        has_library 'libX11.so.6' || missing+=(libx11-6)
+        has_library 'libgomp.so.1' || missing+=(libgomp1)
+        ;;
+    browser)
+        if [ -x /usr/bin/chromium ] || [ -x /usr/bin/chromium-browser ] || [ -n "${PCL_CHROMIUM:-}" ]; then
+            :
+        elif [ "$distribution" = debian ]; then
+            missing+=(chromium)
+        else
+            # Ubuntu's chromium-browser is a snap, which containers lack: Playwright's own build instead.
+            advice+=("no Chromium: run \`.venv/bin/python -m playwright install --with-deps chromium\` after set-up, or set PCL_CHROMIUM to a Chromium binary (tests/project/test_browser.py)")
+        fi
+        ;;
+    *)
+        echo "system-deps.sh: unknown group $group (grading, book, browser)" >&2
+        exit 2
+        ;;
+    esac
+done
+for line in "${advice[@]+"${advice[@]}"}"; do echo "note: $line" >&2; done
 
 [ ${#missing[@]} -eq 0 ] && exit 0
 
@@ -21,9 +57,11 @@ if [ "$(id -u)" -eq 0 ] && command -v apt-get >/dev/null 2>&1; then
     export DEBIAN_FRONTEND=noninteractive
     apt-get update -qq
     apt-get install -y -qq --no-install-recommends "${missing[@]}"
-else
-    echo "Missing system packages: ${missing[*]}" >&2
-    echo "Install them, then run make again:" >&2
+elif command -v apt-get >/dev/null 2>&1; then
+    echo "Missing system packages: ${missing[*]}. Install them, then run make again:" >&2
     echo "    sudo apt-get install -y ${missing[*]}" >&2
+    exit 1
+else
+    echo "Missing system packages (Debian/Ubuntu names): ${missing[*]}. Install their equivalents, then run make again (README \"Set-up\")." >&2
     exit 1
 fi

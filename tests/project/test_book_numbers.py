@@ -55,7 +55,7 @@ def book_pages():
 
 def allowed_versions():
     versions = {f"{sys.version_info.major}.{sys.version_info.minor}"}
-    for line in (REPO_ROOT / "requirements.txt").read_text().splitlines():
+    for line in (REPO_ROOT / "requirements" / "course.txt").read_text().splitlines():
         match = re.match(r"[\w.-]+==(\d+)\.(\d+)", line)
         if match:
             versions.add(f"{match[1]}.{match[2]}")

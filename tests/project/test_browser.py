@@ -6,6 +6,7 @@ _build/screenshots/ for a person to look at."""
 
 import functools
 import http.server
+import os
 import re
 import shutil
 import threading
@@ -15,7 +16,9 @@ from test_book import HTML, page, pytestmark, toc_files  # noqa: F401 -- pytestm
 
 from grading import REPO_ROOT
 
-CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+# Debian's chromium, Ubuntu's chromium-browser, or any build named by
+# PCL_CHROMIUM; None: Playwright's own downloaded build (`playwright install`).
+CHROMIUM = os.environ.get("PCL_CHROMIUM") or shutil.which("chromium") or shutil.which("chromium-browser")
 SCREENSHOTS = REPO_ROOT / "_build" / "screenshots"
 CHROMIUM_ARGS = [
     "--headless",
@@ -51,9 +54,11 @@ def site():
 def browser():
     from playwright.sync_api import sync_playwright
 
-    assert shutil.which(CHROMIUM), "Chromium is missing: `make setup` installs Debian's chromium package"
     with sync_playwright() as playwright:
-        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        try:
+            browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        except Exception as exc:  # playwright's own Error: no browser at all
+            pytest.fail(f'no Chromium ({str(exc).splitlines()[0]}): README "Set-up" says how to install one')
         yield browser
         browser.close()
 

@@ -2,6 +2,7 @@
 not, that its grader gives the stubs 0 points without an error, and that
 the reference's code is caught if it slips in."""
 
+import os
 import shutil
 import subprocess
 import sys
@@ -12,6 +13,7 @@ from _helpers import load_results
 
 from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.leakcheck import find_leaks
+from grading.shipping import INSTRUCTOR_ONLY_GRADER
 
 
 @pytest.fixture(scope="module")
@@ -32,13 +34,15 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
     for needed in (
         "Makefile",
         "README.md",
-        "requirements.txt",
+        "requirements/student.txt",
+        "requirements/grading.txt",
         "pyproject.toml",
         "_config.yml",
         "_toc.yml",
-        ".ci/run",
         ".github/workflows/check.yml",
+        ".github/grader.sha256",
         "scripts/system-deps.sh",
+        "scripts/check_python.py",
         "pcl_course/pca.py",
         "grading/cli.py",
         "tests/graded/test_pca.py",
@@ -53,6 +57,10 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
         "tests/project",
         "tests/hidden",
         ".git",
+        ".ci",
+        "requirements/course.txt",
+        "requirements/course.in",
+        *INSTRUCTOR_ONLY_GRADER,
     ):
         assert not (release_dir / absent).exists(), absent
     for module in EXERCISE_MODULES:
@@ -105,30 +113,93 @@ def test_the_leak_check_sees_through_renaming(release_dir, tmp_path):
     assert any("chamfer_distance" in leak and "metrics.py" in leak for leak in leaks), leaks
 
 
+def workflow_steps(text):
+    return {step.get("id", step.get("name")): step for step in yaml.safe_load(text)["jobs"]["check"]["steps"]}
+
+
 def test_the_workflow_grades_with_a_pristine_grader_in_the_sandbox(release_dir):
     text = (release_dir / ".github" / "workflows" / "check.yml").read_text()
-    assert "classroom" not in text.lower()
+    assert "classroom" not in text.lower() and "advisory" in text.lower()
     workflow = yaml.safe_load(text)
-    steps = workflow["jobs"]["check"]["steps"]
-    checkouts = [s["with"] for s in steps if s.get("uses", "").startswith("actions/checkout")]
-    # The student's repository and, apart from it, the course's: its grader grades.
-    assert [c["path"] for c in checkouts] == ["submission", "course"]
-    assert checkouts[1]["repository"] == "${{ vars.PCL_COURSE_REPOSITORY }}"
-    grading = next(s for s in steps if "python -m grading grade" in s.get("run", ""))
-    assert grading["working-directory"] == "course"
-    assert "../submission" in grading["run"] and "--require-isolation" in grading["run"]
-    setup = next(s for s in steps if "apt-get install" in s.get("run", ""))
-    assert "bubblewrap" in setup["run"] and "course/requirements.txt" in setup["run"]
-    assert any("GITHUB_STEP_SUMMARY" in s.get("run", "") for s in steps)
-    assert "advisory" in text.lower()
+    assert workflow["jobs"]["check"]["env"]["COURSE_REPOSITORY"] == "${{ vars.PCL_COURSE_REPOSITORY }}"
+    steps = workflow_steps(text)
+    uses = {step["uses"].split("@")[0]: step["uses"].split("@")[1] for step in steps.values() if "uses" in step}
+    assert uses == {"actions/checkout": "v6", "actions/setup-python": "v6"}
+    # A private course repository is read with the instructors' token.
+    assert steps["course"]["with"]["token"] == "${{ secrets.PCL_COURSE_TOKEN || github.token }}"
+    assert steps["course"]["if"] == "steps.grader.outputs.source == 'course'"
+    assert steps["hashes"]["if"] == "steps.grader.outputs.source == 'hashes'"
+    python = next(step for step in steps.values() if step.get("uses", "").startswith("actions/setup-python"))
+    assert python["with"]["cache"] == "pip"
+    assert steps["grade"]["working-directory"] == "course"
+    assert "../submission" in steps["grade"]["run"] and "--require-isolation" in steps["grade"]["run"]
+    assert "bubblewrap" in steps["setup"]["run"] and "course/requirements/grading.txt" in steps["setup"]["run"]
+    summary = next(step for step in steps.values() if "GITHUB_STEP_SUMMARY" in step.get("run", ""))
+    assert summary["if"] == "always()" and "working-directory" not in summary
 
 
 def test_the_workflow_names_the_course_repository_when_given(tmp_path):
     from grading.release import _student_workflow
 
     workflow = yaml.safe_load(_student_workflow("cs-dept/pcl-course-2027"))
-    checkout = [s for s in workflow["jobs"]["check"]["steps"] if s.get("uses", "").startswith("actions/checkout")]
-    assert checkout[1]["with"]["repository"] == "cs-dept/pcl-course-2027"
+    assert workflow["jobs"]["check"]["env"]["COURSE_REPOSITORY"] == "cs-dept/pcl-course-2027"
+
+
+def run_step(step, cwd, env=None, timeout=60):
+    return subprocess.run(
+        ["bash", "-e", "-c", step["run"]],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env={**os.environ, **(env or {})},
+    )
+
+
+def test_the_workflow_trusts_its_own_grader_only_as_released(release_dir, tmp_path):
+    steps = workflow_steps((release_dir / ".github" / "workflows" / "check.yml").read_text())
+    chosen = run_step(steps["grader"], tmp_path, {"COURSE_REPOSITORY": "", "GITHUB_OUTPUT": str(tmp_path / "out")})
+    assert chosen.returncode == 0 and (tmp_path / "out").read_text() == "source=hashes\n"
+    for change in (None, "edited", "added", "removed"):
+        workspace = tmp_path / str(change)
+        submission = workspace / "submission"
+        shutil.copytree(release_dir, submission, ignore=shutil.ignore_patterns("_build", "r.json", "__pycache__"))
+        if change == "edited":
+            (submission / "tests" / "graded" / "test_pca.py").write_text("def test_free(impl):\n    pass\n")
+        elif change == "added":
+            (submission / "tests" / "graded" / "conftest.py").write_text("")
+        elif change == "removed":
+            (submission / "grading" / "forbidden.py").unlink()
+        completed = run_step(steps["hashes"], submission)
+        if change is None:
+            assert completed.returncode == 0, completed.stdout + completed.stderr
+            assert (workspace / "course" / "tests" / "graded" / "test_pca.py").is_file()
+            assert (workspace / "course" / "grading" / "plugin.py").is_file()
+        else:
+            assert completed.returncode == 1, change
+            assert "differs from the release" in completed.stdout, change
+            assert not (workspace / "course").exists()
+
+
+@pytest.mark.parametrize(
+    "outcomes, expected",
+    [
+        ({"COURSE": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "PCL_COURSE_TOKEN"),
+        ({"HASHES": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "differs from the release"),
+        ({"HASHES": "success", "SETUP": "failure", "GRADE": "skipped"}, "the set-up step failed"),
+        ({"HASHES": "success", "SETUP": "success", "GRADE": "success"}, "Total: 1 / 2"),
+    ],
+)
+def test_the_workflow_summary_says_why_grading_did_not_run(release_dir, tmp_path, outcomes, expected):
+    steps = workflow_steps((release_dir / ".github" / "workflows" / "check.yml").read_text())
+    summary = next(step for step in steps.values() if "GITHUB_STEP_SUMMARY" in step.get("run", ""))
+    if outcomes["GRADE"] == "success":
+        (tmp_path / "results").mkdir()
+        (tmp_path / "results" / "marks.txt").write_text("Total: 1 / 2\n")
+    env = {"COURSE": "", "HASHES": "", "GRADER": "x", "COURSE_REPOSITORY": "a/b", **outcomes}
+    completed = run_step(summary, tmp_path, {**env, "GITHUB_STEP_SUMMARY": str(tmp_path / "summary.md")})
+    assert completed.returncode == 0, completed.stderr
+    assert expected in (tmp_path / "summary.md").read_text()
 
 
 def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
@@ -203,12 +274,12 @@ def test_the_workflow_grade_step_runs_the_pristine_grader_on_the_submission(rele
 
 
 def test_every_substitution_must_match_exactly_once():
-    from grading.release import _substitute
+    from grading.shipping import substitute
 
-    assert _substitute("a = 1\nb = 2\n", "a = 1", "a = 3", "x") == "a = 3\nb = 2\n"
+    assert substitute("a = 1\nb = 2\n", "a = 1", "a = 3", "x") == "a = 3\nb = 2\n"
     for text in ("b = 2\n", "a = 1\na = 1\n"):
         with pytest.raises(SystemExit, match="exactly once in x"):
-            _substitute(text, "a = 1", "a = 3", "x")
+            substitute(text, "a = 1", "a = 3", "x")
 
 
 def test_the_student_makefile_shares_the_set_up_rules(release_dir):
