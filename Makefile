@@ -1,6 +1,8 @@
 # 3D Point Cloud Processing, Lecture 1: set-up, book, tests and grading.
 #   make book     set up, then build the book into _build/html
 #   make test     set up, lint, build the book, run the whole test suite
+#   make test-images  build Gradescope's image and the README's set-up on Ubuntu 22.04
+#                 and Debian 12 from their archives (slow; root; not part of make test)
 #   make lint     ruff check and ruff format --check (rules in pyproject.toml)
 #   make grade SUBMISSION=dir    grade a student's clone
 #   make requirements   re-pin requirements/ (the lock and its two subsets)
@@ -12,7 +14,7 @@ GRADESCOPE_ZIP ?= _build/gradescope/autograder.zip
 
 include scripts/setup.mk
 
-.PHONY: lint book notebooks test grade gradescope bench requirements clean
+.PHONY: lint book notebooks test test-images grade gradescope bench requirements clean
 
 # The execution cache keys on each page's own code only: when the package code
 # the pages run changes, drop the cache (and Sphinx's saved environment, or it
@@ -43,6 +45,11 @@ lint: setup
 test: lint book notebooks
 	$(BIN)/python -m pytest -n auto --durations=20
 	$(BIN)/python -m pytest -n auto --dist loadfile --nbval-lax _build/notebooks
+
+# tests/images: debootstrap roots of the distributions, run with bwrap (README
+# "Environments"). About 10 minutes; the roots are kept in build/images.
+test-images: setup
+	$(BIN)/python -m pytest tests/images -p no:xdist -p no:cacheprovider -o timeout=3600 -v -s
 
 grade: setup
 	@test -n "$(SUBMISSION)" || { echo "usage: make grade SUBMISSION=path/to/student/clone"; exit 2; }

@@ -3,10 +3,10 @@
 # .venv with the pinned requirements and this package.
 #   PYTHON        the interpreter to build .venv with (Python 3.11 or newer)
 #   REQUIREMENTS  the pinned set (the course's full lock; students: their subset)
-#   SYSTEM_DEPS   what scripts/system-deps.sh provides: grading, book, browser
+#   SYSTEM_DEPS   what scripts/system-deps.sh provides: grading, book, build, browser
 PYTHON       ?= python3
 REQUIREMENTS ?= requirements/course.txt
-SYSTEM_DEPS  ?= grading book browser
+SYSTEM_DEPS  ?= grading book build browser
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.setup-done

@@ -1,18 +1,20 @@
 #!/usr/bin/env bash
 # Install the system packages the course needs, or say exactly how to.
-#   scripts/system-deps.sh [grading] [book] [browser]
+#   scripts/system-deps.sh [grading] [book] [build] [browser]
 #     grading : bubblewrap, the grader's sandbox (bwrap) for students' code; acl
 #               (setfacl), with which the grader, as root without namespaces, bars
 #               its sandbox uids from the forbidden packages (grading/sandbox.py)
 #     book    : the shared libraries Open3D's wheel links against (libusb, libGL,
 #               libEGL, libX11, libgomp): without them `import open3d` fails
+#     build   : a C++ compiler: fpsample, a benchmark peer, is published as source only
+#               (instructors only)
 #     browser : Chromium, which the book's page tests drive (instructors only)
 # A package is missing when its library or command is: the check is by file,
 # so another distribution's package that provides it counts too.
 set -euo pipefail
 
 groups=("$@")
-[ ${#groups[@]} -gt 0 ] || groups=(grading book browser)
+[ ${#groups[@]} -gt 0 ] || groups=(grading book build browser)
 distribution=$(. /etc/os-release 2>/dev/null && echo "${ID:-unknown}" || echo unknown)
 
 has_library() { ldconfig -p 2>/dev/null | grep -q "$1"; }
@@ -32,6 +34,9 @@ for group in "${groups[@]}"; do
         has_library 'libX11.so.6' || missing+=(libx11-6)
         has_library 'libgomp.so.1' || missing+=(libgomp1)
         ;;
+    build)
+        command -v g++ >/dev/null 2>&1 || missing+=(g++)
+        ;;
     browser)
         if [ -x /usr/bin/chromium ] || [ -x /usr/bin/chromium-browser ] || [ -n "${PCL_CHROMIUM:-}" ]; then
             :
@@ -43,7 +48,7 @@ for group in "${groups[@]}"; do
         fi
         ;;
     *)
-        echo "system-deps.sh: unknown group $group (grading, book, browser)" >&2
+        echo "system-deps.sh: unknown group $group (grading, book, build, browser)" >&2
         exit 2
         ;;
     esac
