@@ -40,6 +40,7 @@ import queue
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
@@ -112,22 +113,78 @@ def grade(args):
 
 
 GRADEBOOK_IDENTITY = ("Student", "ID", "SIS User ID", "SIS Login ID", "Section")  # Canvas's gradebook export
+GRADESCOPE_METADATA = "submission_metadata.yml"  # in Gradescope's "Export Submissions" archive
 
 
-def write_gradebook(path, assignment, graded, roster=None):
+@dataclass
+class Folder:
+    """One entry of a class folder, and what became of it.
+
+    Attributes
+    ----------
+    name : str
+        The folder's name (a student's login, or Gradescope's ``submission_NNN``).
+    submitters : list of dict
+        From Gradescope's metadata: ``name``, ``sid``, ``email`` of each
+        submitter (several for a group); empty without metadata.
+    grading : Grading or None
+        The results, when the folder was graded.
+    status : str
+        ``graded``, or why not: nothing to grade, refused, grading failed.
+    note : str
+        What was graded from where (as on Gradescope), or the reason in full.
+    """
+
+    name: str
+    submitters: list = field(default_factory=list)
+    grading: Grading = None
+    status: str = ""
+    note: str = ""
+
+    def identities(self):
+        """The names a roster row may know this submission by."""
+        keys = {self.name}
+        for person in self.submitters:
+            keys |= {person["sid"], person["email"], person["email"].split("@")[0]}
+        return keys - {""}
+
+
+def read_gradescope_metadata(root):
+    """Folder name -> submitters, from Gradescope's ``submission_metadata.yml`` (empty without one)."""
+    path = root / GRADESCOPE_METADATA
+    if not path.is_file():
+        return {}
+    import yaml
+
+    metadata = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
+    people = {}
+    for folder, record in metadata.items():
+        submitters = (record or {}).get(":submitters") or []
+        people[str(folder)] = [
+            {key: str(person.get(f":{key}") or "").strip() for key in ("name", "sid", "email")} for person in submitters
+        ]
+    return people
+
+
+def write_gradebook(path, assignment, folders, roster=None):
     """Write the marks in the layout of Canvas's gradebook (its export, re-imported).
 
     Columns ``Student, ID, SIS User ID, SIS Login ID, Section`` and one
     column ``assignment`` holding each total, after a ``Points Possible``
     row. With ``roster`` (a gradebook exported from the course), each
-    submission folder is matched to the student whose SIS Login ID, SIS
-    User ID or ID it is named after, and every identity column is copied
-    from the roster; students without a submission get an empty cell (no
-    change on import). Without it, the folder name fills ``Student`` and
-    ``SIS Login ID``.
+    submission is matched to the student whose SIS Login ID, SIS User ID or
+    ID is its folder's name or, with Gradescope's metadata, a submitter's
+    SID, email or email login; every identity column is copied from the
+    roster. A folder that held nothing gradable, or was refused, scores 0,
+    as on Gradescope (marks.csv says why); students without a folder get an
+    empty cell (no change on import). Without a roster, one row per folder
+    (per submitter, with metadata).
     """
-    marks = {name: summary for name, summary, _ in graded}
-    possible = max((s.max_score for s in marks.values() if s), default=0)
+    possible = max((f.grading.max_score for f in folders if f.grading), default=0)
+
+    def mark(folder):
+        return f"{folder.grading.score:g}" if folder.grading else "0"
+
     rows = []
     if roster:
         with open(roster, newline="", encoding="utf-8-sig") as handle:
@@ -139,15 +196,19 @@ def write_gradebook(path, assignment, graded, roster=None):
             )
         matched = set()
         for student in students:
-            keys = [student.get(c, "").strip() for c in ("SIS Login ID", "SIS User ID", "ID")]
-            name = next((key for key in keys if key and key in marks), None)
-            summary = marks.get(name)
-            matched.add(name)
-            rows.append([*(student.get(c, "") for c in GRADEBOOK_IDENTITY), f"{summary.score:g}" if summary else ""])
-        for name in sorted(set(marks) - matched):
-            print(f"{name}: in no roster row (by SIS Login ID, SIS User ID or ID): not in the gradebook file")
+            keys = {student.get(c, "").strip() for c in ("SIS Login ID", "SIS User ID", "ID")} - {""}
+            folder = next((f for f in folders if f.identities() & keys), None)
+            matched.add(folder.name if folder else None)
+            rows.append([*(student.get(c, "") for c in GRADEBOOK_IDENTITY), mark(folder) if folder else ""])
+        for folder in folders:
+            if folder.name not in matched:
+                print(
+                    f"{folder.name}: in no roster row (by SIS Login ID, SIS User ID or ID): not in the gradebook file"
+                )
     else:
-        rows = [[name, "", "", name, "", f"{s.score:g}" if s else ""] for name, s in marks.items()]
+        for folder in folders:
+            people = folder.submitters or [{"name": folder.name, "sid": "", "email": folder.name}]
+            rows += [[p["name"], "", p["sid"], p["email"] or folder.name, "", mark(folder)] for p in people]
     with open(path, "w", newline="") as handle:
         writer = csv.writer(handle)
         writer.writerow([*GRADEBOOK_IDENTITY, assignment])
@@ -156,12 +217,21 @@ def write_gradebook(path, assignment, graded, roster=None):
     print(f"Gradebook (Canvas layout, column {assignment!r}) written to {path}")
 
 
+def class_folders(root):
+    """Every entry of the class folder, in name order: hidden entries and Gradescope's metadata aside."""
+    entries = sorted(p for p in root.iterdir() if not p.name.startswith(".") and p.name != GRADESCOPE_METADATA)
+    if not entries:
+        raise SystemExit(f"error: {root} is empty")
+    return entries
+
+
 def batch(args):
+    from grading.errors import StagingError
+    from grading.gradescope import assemble
+
     root = Path(args.directory).resolve()
-    # lexists: a linked submission or pcl_course is listed, then refused by staging.
-    submissions = sorted(p for p in root.iterdir() if os.path.lexists(p / "pcl_course"))
-    if not submissions:
-        raise SystemExit(f"error: no subdirectory of {root} holds a pcl_course/ package")
+    entries = class_folders(root)
+    metadata = read_gradescope_metadata(root)
     out = Path(args.out).resolve() if args.out else root.parent / f"{root.name}-results"
     out.mkdir(parents=True, exist_ok=True)
     jobs = max(1, min(args.jobs or os.cpu_count() or 1, config.SANDBOX_UID_SLOTS))
@@ -191,49 +261,68 @@ def batch(args):
     for slot in range(jobs):
         slots.put(config.SANDBOX_UID_BASE + slot)
 
-    def grade_one(submission):
-        results = out / f"{submission.name}.json"
-        uid = slots.get()
-        try:
-            code, output = run_graded_tests(
-                submission / "pcl_course", results, args.k, sandbox=True, require_isolation=require, sandbox_uid=uid
-            )
-        finally:
-            slots.put(uid)
+    def grade_one(entry):
+        folder = Folder(entry.name, metadata.get(entry.name, []))
+        if entry.is_symlink() or not entry.is_dir():
+            folder.status, folder.note = "not graded", "not a folder (a link or a file): nothing graded"
+            return folder, ""
+        # Laid over the course's stubs as on Gradescope: a whole clone, its pcl_course/, or loose modules.
+        with tempfile.TemporaryDirectory(prefix="batch-", dir=out) as work:
+            try:
+                package, folder.note = assemble(entry, work)
+            except StagingError as exc:
+                folder.status, folder.note = "not graded", f"refused: {exc}"
+                return folder, ""
+            results = out / f"{entry.name}.json"
+            uid = slots.get()
+            try:
+                code, output = run_graded_tests(
+                    package, results, args.k, sandbox=True, require_isolation=require, sandbox_uid=uid, note=folder.note
+                )
+            finally:
+                slots.put(uid)
         if code not in (0, 1) or not results.exists():
-            return submission.name, None, output
-        return submission.name, Grading.from_gradescope(json.loads(results.read_text())), output
+            folder.status = "grading failed"
+            return folder, output
+        folder.grading, folder.status = Grading.from_gradescope(json.loads(results.read_text())), "graded"
+        return folder, output
 
     # Each grading is its own pytest process: threads only wait for them.
     with ThreadPoolExecutor(max_workers=jobs) as pool:
-        graded = list(pool.map(grade_one, submissions))
+        graded = list(pool.map(grade_one, entries))
+    folders = [folder for folder, _ in graded]
 
-    functions = [f for f in GRADED_FUNCTIONS if any(r and f in r.per_function() for _, r, _ in graded)]
+    functions = [f for f in GRADED_FUNCTIONS if any(d.grading and f in d.grading.per_function() for d in folders)]
     csv_path = Path(args.csv) if args.csv else out / "marks.csv"
     with open(csv_path, "w", newline="") as handle:
         writer = csv.writer(handle)
-        writer.writerow(["submission", "score", "max_score", "status", *functions])
-        for name, summary, _ in graded:
-            if summary is None:
-                writer.writerow([name, 0, "", "grading failed", *[""] * len(functions)])
+        writer.writerow(["submission", "submitters", "score", "max_score", "status", "note", *functions])
+        for folder in folders:
+            people = "; ".join(f"{p['name']} <{p['email']}> {p['sid']}".strip() for p in folder.submitters)
+            if folder.grading is None:
+                writer.writerow([folder.name, people, 0, "", folder.status, folder.note, *[""] * len(functions)])
                 continue
-            per_function = summary.per_function()
+            per_function = folder.grading.per_function()
             writer.writerow(
                 [
-                    name,
-                    f"{summary.score:g}",
-                    f"{summary.max_score:g}",
-                    "graded",
+                    folder.name,
+                    people,
+                    f"{folder.grading.score:g}",
+                    f"{folder.grading.max_score:g}",
+                    folder.status,
+                    folder.note,
                     *[f"{per_function.get(f, (0, 0))[0]:g}" for f in functions],
                 ]
             )
     if args.gradebook:
-        write_gradebook(args.gradebook, args.assignment, graded, args.roster)
-    for name, summary, output in graded:
-        mark = f"{summary.score:g} / {summary.max_score:g}" if summary else "grading failed"
-        print(f"{name}: {mark}")
-        if summary is None:
+        write_gradebook(args.gradebook, args.assignment, folders, args.roster)
+    for folder, output in graded:
+        mark = f"{folder.grading.score:g} / {folder.grading.max_score:g}" if folder.grading else folder.status
+        print(f"{folder.name}: {mark}" + ("" if folder.grading else f" ({folder.note})" if folder.note else ""))
+        if folder.status == "grading failed":
             print(output, file=sys.stderr)
+    counts = {status: sum(f.status == status for f in folders) for status in ("graded", "not graded", "grading failed")}
+    print(f"{len(folders)} entries: " + ", ".join(f"{n} {status}" for status, n in counts.items() if n))
     print(f"Marks written to {csv_path}; results files in {out}")
     return 0
 
@@ -258,6 +347,7 @@ def similarity(args):
 
 
 INSTRUCTOR_COMMANDS = {
+    "batch": "grading.gradescope",
     "release": "grading.release",
     "gradescope": "grading.gradescope",
     "similarity": "grading.similarity",
@@ -305,7 +395,11 @@ def main(argv=None):
     )  # mutation checks: replace one module
     g.add_argument("--diagnose-always", action="store_true", help=argparse.SUPPRESS)  # false-diagnosis checks
     b = commands.add_parser("batch", help="grade every submission in a folder, in parallel")
-    b.add_argument("directory", help="a folder with one student clone (holding pcl_course/) per subdirectory")
+    b.add_argument(
+        "directory",
+        help="a folder with one submission per subdirectory (a clone, its pcl_course/, or loose modules), "
+        "or Gradescope's exported submissions with their submission_metadata.yml",
+    )
     b.add_argument("--csv", help="where to write the marks (default: OUT/marks.csv)")
     b.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
     b.add_argument("--jobs", type=int, help="submissions graded at once (default: number of cores)")

@@ -29,7 +29,8 @@ def test_batch_grades_every_submission_and_writes_a_csv(tmp_path):
     rows = run_batch(
         classroom, tmp_path / "marks.csv", "--jobs", "2", "-k", "test_chamfer_distance_ or test_depth_metrics_"
     )
-    assert set(rows) == {"alice", "bob", "carol"}
+    assert set(rows) == {"alice", "bob", "carol", "notes.txt"}
+    assert rows["notes.txt"]["status"] == "not graded" and "not a folder" in rows["notes.txt"]["note"]
     assert rows["alice"]["score"] == rows["alice"]["max_score"] != "0"
     assert rows["bob"]["score"] == "0"
     assert rows["carol"]["chamfer_distance"] != rows["alice"]["chamfer_distance"]
@@ -73,3 +74,79 @@ def test_batch_writes_a_canvas_gradebook_matched_to_the_roster(tmp_path):
     assert rows[3] == ["Builder, Bob", "102", "S-2", "bob02", "Sec A", "0"]
     assert rows[4] == ["Late, Carol", "103", "S-3", "carol03", "Sec B", ""]  # no submission: no change
     assert len(rows) == 5  # zed99 matched nobody: reported, not invented
+
+
+GRADESCOPE_METADATA = """\
+submission_31415926:
+  :submitters:
+  - :name: Dana Scully
+    :sid: S-4
+    :email: dana04@example.edu
+  :created_at: 2027-02-01 10:00:00.000000000 +00:00
+  :score: 0.0
+  :status: processed
+"""
+
+
+def test_batch_accounts_for_every_folder_in_five_layouts(tmp_path):
+    from _helpers import reference_source
+
+    classroom = tmp_path / "class"
+    make_submission(classroom, "alice01", [REPO_ROOT / "solutions" / "metrics.py"])  # a whole clone
+    (classroom / "empty02").mkdir()  # an empty upload
+    loose = classroom / "loose03"  # loose modules, as Gradescope accepts them
+    loose.mkdir()
+    (loose / "metrics.py").write_text(reference_source("metrics"))
+    (loose / "helper_notes.py").write_text("x = 1\n")
+    exported = classroom / "submission_31415926"  # Gradescope's export: a folder per submission
+    exported.mkdir()
+    (exported / "metrics.py").write_text(reference_source("metrics"))
+    (classroom / "submission_metadata.yml").write_text(GRADESCOPE_METADATA)
+    refused = make_submission(classroom, "eve05", [])  # a link out of the submission: refused
+    (refused / "metrics.py").unlink()
+    (refused / "metrics.py").symlink_to("/etc/passwd")
+    roster = tmp_path / "export.csv"
+    roster.write_text(
+        "Student,ID,SIS User ID,SIS Login ID,Section\n"
+        "    Points Possible,,,,\n"
+        + "".join(f"S{i},{100 + i},S-{i},{login},A\n" for i, login in enumerate(["alice01", "empty02", "loose03"], 1))
+        + "Dana Scully,104,S-4,dana04,A\nEve,105,S-5,eve05,A\nFrank,106,S-6,frank06,A\n"
+    )
+    gradebook = tmp_path / "canvas.csv"
+    rows = run_batch(
+        classroom,
+        tmp_path / "marks.csv",
+        "-k",
+        "test_chamfer_distance_",
+        "--gradebook",
+        str(gradebook),
+        "--roster",
+        str(roster),
+        "--assignment",
+        "L1",
+    )
+    assert set(rows) == {"alice01", "empty02", "loose03", "submission_31415926", "eve05"}
+    full = rows["alice01"]["max_score"]
+    assert rows["alice01"]["status"] == "graded" and rows["alice01"]["score"] == full != "0"
+    assert rows["empty02"]["status"] == "not graded" and "no pcl_course/ folder" in rows["empty02"]["note"]
+    assert (
+        rows["loose03"]["score"] == full
+        and "Not graded (not exercise modules): `helper_notes.py`" in rows["loose03"]["note"]
+    )
+    assert rows["submission_31415926"]["score"] == full
+    assert rows["submission_31415926"]["submitters"] == "Dana Scully <dana04@example.edu> S-4"
+    assert rows["eve05"]["status"] == "not graded" and rows["eve05"]["note"].startswith("refused:")
+    import csv
+
+    with open(gradebook, newline="") as handle:
+        marks = {row["SIS Login ID"]: row["L1"] for row in csv.DictReader(handle)}
+    # Dana is matched through the metadata's SID; Frank has no folder: no change on import.
+    assert marks == {
+        "": marks[""],  # the Points Possible row
+        "alice01": full,
+        "empty02": "0",
+        "loose03": full,
+        "dana04": full,
+        "eve05": "0",
+        "frank06": "",
+    }
