@@ -328,7 +328,7 @@ def batch(args):
 
 
 def similarity(args):
-    from grading.similarity import DISPLAY_THRESHOLD, compare_class, render_report
+    from grading.similarity import DISPLAY_THRESHOLD, compare_class, counted, render_report
 
     root = Path(args.directory)
     if not root.is_dir():
@@ -342,7 +342,7 @@ def similarity(args):
     shown = [p for p in pairs if p.similarity >= threshold][: args.top]
     for pair in shown[:10]:
         print(f"{pair.similarity:4.0%}  {pair.module}.py  {pair.first}  {pair.second}")
-    print(f"{len(shown)} pairs at or above {threshold:.0%}; report written to {report}")
+    print(f"{counted(len(shown), 'pair')} at or above {threshold:.0%}; report written to {report}")
     return 0
 
 

@@ -166,10 +166,16 @@ table { border-collapse: collapse; margin-bottom: 2em; }
 th, td { border: 1px solid #ccc; padding: 0.3em 0.7em; text-align: left; }
 td.number { text-align: right; font-variant-numeric: tabular-nums; }
 .pair { margin: 2em 0; border-top: 2px solid #888; }
-.sides { display: grid; grid-template-columns: 1fr 1fr; gap: 1em; }
+/* minmax(0, ...): a long line scrolls inside its pane instead of widening the page */
+.sides { display: grid; grid-template-columns: minmax(0, 1fr) minmax(0, 1fr); gap: 1em; }
 pre { background: #f7f7f7; padding: 0.7em; overflow-x: auto; font-size: 0.85em; }
 mark.shared { background: #ffd0d0; }
 """
+
+
+def counted(n, noun):
+    """``"1 pair"``, ``"2 pairs"``."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
 def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
@@ -196,7 +202,8 @@ def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
 <html lang="en"><head><meta charset="utf-8"><title>Similarity report</title>
 <style>{STYLE}</style></head><body>
 <h1>Similarity of the exercise modules</h1>
-<p>{len(pairs)} pairs share code beyond the stubs; {len(shown)} reach {threshold:.0%} of a file and are shown.
+<p>{counted(len(pairs), "pair")} share code beyond the stubs; {len(shown)} reach{"es" if len(shown) == 1 else ""} \
+{threshold:.0%} of a file and {"is" if len(shown) == 1 else "are"} shown.
 The share is the part of a student's file (stub text removed, names folded) that the other file holds too.
 A high share is a reason to read both files, not a verdict.</p>
 {f"<ul>{notes}</ul>" if notes else ""}

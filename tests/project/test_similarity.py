@@ -7,6 +7,7 @@ rank first, the independent solutions must stay below the display
 threshold, and the stub's own text must never make a pair.
 """
 
+import dataclasses
 import re
 import shutil
 import subprocess
@@ -145,3 +146,29 @@ def test_the_report_is_one_self_contained_page_with_the_shared_code_marked(plant
     assert not re.search(r"""(src|href)=["'](https?:)?//""", page)  # nothing fetched from the web
     assert "<script>" not in page and "&lt;script&gt;" in page  # students' text is escaped
     assert "from solutions" not in page and "Test constancy on the data" not in page  # no link was followed
+
+
+def test_the_report_fits_1280_px_and_counts_in_english(planted_class, tmp_path):
+    from playwright.sync_api import sync_playwright
+    from test_browser import CHROMIUM, CHROMIUM_ARGS
+
+    from grading.similarity import compare_class, counted, render_report
+
+    assert (counted(1, "pair"), counted(2, "pair")) == ("1 pair", "2 pairs")
+    pairs, skipped = compare_class(planted_class)
+    # A long line in a shared file: it scrolls inside its pane, never widens the page.
+    long_line = "x = [" + ", ".join(["1.0"] * 200) + "]"
+    pairs[0] = dataclasses.replace(pairs[0], second_html=pairs[0].second_html + long_line)
+    report = tmp_path / "similarity.html"
+    report.write_text(render_report(pairs[:1], skipped, threshold=0))
+    assert "1 pair share" in report.read_text() and "1 pairs" not in report.read_text()
+    with sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        tab = browser.new_page(viewport={"width": 1280, "height": 900})
+        tab.goto(report.as_uri())
+        overflow = tab.evaluate("document.documentElement.scrollWidth - document.documentElement.clientWidth")
+        right = tab.evaluate(
+            "Math.max(...[...document.querySelectorAll('pre')].map(p => p.getBoundingClientRect().right))"
+        )
+        browser.close()
+    assert overflow <= 0 and right <= 1280, (overflow, right)
