@@ -18,7 +18,7 @@ setup: $(STAMP)
 # A .venv left by a failed or older set-up, built with an interpreter below
 # the floor, is rebuilt rather than reused.
 $(STAMP): $(REQUIREMENTS) pyproject.toml scripts/system-deps.sh scripts/setup.mk scripts/check_python.py
-	bash scripts/system-deps.sh $(SYSTEM_DEPS)
+	PYTHON=$(PYTHON) bash scripts/system-deps.sh $(SYSTEM_DEPS)
 	@$(PYTHON) scripts/check_python.py
 	@if [ -e $(VENV) ] && ! $(BIN)/python scripts/check_python.py 2>/dev/null; then \
 	    echo "Rebuilding $(VENV): it was made by an unsupported or missing Python"; rm -rf $(VENV); fi

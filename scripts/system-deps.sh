@@ -6,8 +6,8 @@
 #               its sandbox uids from the forbidden packages (grading/sandbox.py)
 #     book    : the shared libraries Open3D's wheel links against (libusb, libGL,
 #               libEGL, libX11, libgomp): without them `import open3d` fails
-#     build   : a C++ compiler: fpsample, a benchmark peer, is published as source only
-#               (instructors only)
+#     build   : a C++ compiler and $PYTHON's headers: fpsample, a benchmark peer, is
+#               published as source only (instructors only)
 #     browser : Chromium, which the book's page tests drive (instructors only)
 # A package is missing when its library or command is: the check is by file,
 # so another distribution's package that provides it counts too.
@@ -36,6 +36,12 @@ for group in "${groups[@]}"; do
         ;;
     build)
         command -v g++ >/dev/null 2>&1 || missing+=(g++)
+        python=${PYTHON:-python3}
+        if command -v "$python" >/dev/null 2>&1; then
+            headers=$("$python" -c 'import sysconfig; print(sysconfig.get_paths()["include"])')
+            version=$("$python" -c 'import sys; print("%d.%d" % sys.version_info[:2])')
+            [ -f "$headers/Python.h" ] || missing+=("python$version-dev")
+        fi
         ;;
     browser)
         if [ -x /usr/bin/chromium ] || [ -x /usr/bin/chromium-browser ] || [ -n "${PCL_CHROMIUM:-}" ]; then

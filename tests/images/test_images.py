@@ -143,7 +143,8 @@ def test_the_gradescope_image_builds_and_grades(image_root, tmp_path):
 
     reference = gradescope_results(root, lambda submission: reference_package(submission / "pcl_course"))
     assert reference["extra_data"]["isolation"].startswith("isolated")
-    assert all(test["score"] == test["max_score"] for test in reference["tests"])
+    lost = [(t["name"], t.get("output", "")[:300]) for t in reference["tests"] if t["score"] < t["max_score"]]
+    assert not lost, lost[:5]
     stubs = gradescope_results(
         root, lambda submission: shutil.copytree(REPO_ROOT / "pcl_course", submission / "pcl_course")
     )
