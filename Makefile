@@ -78,15 +78,13 @@ bench: setup
 # its two subsets, grading.txt and student.txt, with the lock as constraints.
 # uv resolves for every platform at once (--universal) and for the oldest
 # supported Python, whatever runs it; the existing pins are kept where they
-# still resolve. README "Environments".
-UV_VERSION   := 0.13.9
+# still resolve. uv itself is pinned in the lock. README "Environments".
 PYTHON_FLOOR := 3.11.0
-UV_COMPILE    = build/uv/bin/uv pip compile --quiet --universal --python-version $(PYTHON_FLOOR) \
+UV_COMPILE    = $(CURDIR)/$(BIN)/uv pip compile --quiet --universal --python-version $(PYTHON_FLOOR) \
                 --custom-compile-command "make requirements"
-requirements:
-	test -x build/uv/bin/uv || { $(PYTHON) -m venv build/uv && build/uv/bin/pip install --quiet uv==$(UV_VERSION); }
-	cd requirements && ../$(UV_COMPILE) course.in -o course.txt
-	cd requirements && for env in grading student; do ../$(UV_COMPILE) $$env.in -c course.txt -o $$env.txt || exit 1; done
+requirements: setup
+	cd requirements && $(UV_COMPILE) course.in -o course.txt
+	cd requirements && for env in grading student; do $(UV_COMPILE) $$env.in -c course.txt -o $$env.txt || exit 1; done
 
 clean:
 	rm -rf _build results build

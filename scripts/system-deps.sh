@@ -13,6 +13,13 @@
 # so another distribution's package that provides it counts too.
 set -euo pipefail
 
+if [ "$(uname -s)" != Linux ]; then
+    # macOS (and others): Open3D's wheels carry their libraries; bubblewrap does not exist there,
+    # so `make test` grades unisolated, as a local check (README "Set-up").
+    echo "note: $(uname -s) is not Linux: no system packages checked; grading here is a local, unisolated check" >&2
+    exit 0
+fi
+
 groups=("$@")
 [ ${#groups[@]} -gt 0 ] || groups=(grading book build browser)
 distribution=$(. /etc/os-release 2>/dev/null && echo "${ID:-unknown}" || echo unknown)
