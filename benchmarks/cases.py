@@ -4,8 +4,8 @@ A :class:`Case` is one function, one variant, one cloud kind and one size;
 its ``implementations`` map a name to a zero-argument callable that runs one
 call. ``reference`` is the course's reference (``solutions``); the others are
 peers from the libraries of the field. A case may carry a *target*: the
-largest allowed ratio of the reference's median time to one peer's, from
-issue 8.
+largest allowed ratio of the reference's median time to one peer's: the
+course's performance targets.
 
 Graded functions without a library peer (``normal_space_sampling``, the
 bilateral filters, ``fit_plane``, ``depth_metrics``) are not here: there is

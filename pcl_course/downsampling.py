@@ -2,8 +2,10 @@
 
 Voxel indexing used by both voxel filters: origin at the per-axis minimum of
 the xyz columns; ``h = floor((p - min) / voxel_size)`` per axis as int64;
-``D = floor((max - min) / voxel_size) + 1`` per axis; linear index
-``h_x + h_y * D_x + h_z * D_x * D_y``.
+the grid size ``G = floor((max - min) / voxel_size) + 1`` per axis; linear
+index ``h_x + h_y * G_x + h_z * G_x * G_y``. (The course's contract writes
+the grid sizes ``D_x, D_y, D_z``; here they are ``G``, since ``D`` is the
+number of columns of ``points``.)
 """
 
 # What every solution needs (NumPy; SciPy's k-d tree is allowed; the course's input checks).
@@ -42,7 +44,7 @@ def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
 
     Notes
     -----
-    Must stay correct when ``D_x * D_y * D_z`` does not fit in int64: never
+    Must stay correct when ``G_x * G_y * G_z`` does not fit in int64: never
     merge two distinct voxels.
 
     Examples

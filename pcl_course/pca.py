@@ -132,7 +132,11 @@ def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
     alphas : ndarray of float64, shape (N, n_components)
         The matching eigenvectors, scaled so that
         ``alphas[:, r] @ alphas[:, r] == 1 / eigenvalues[r]``.
-        The sign of each component is free.
+        The sign of each component is free. An eigenvalue that is zero has
+        no such scaling: its column is all zeros (and its projections are
+        0). ``K~`` always has one (the constant vector), and more when N
+        exceeds the dimension of the feature space; numerically, "zero" is
+        at most ``1e-12`` times the largest eigenvalue, as in scikit-learn.
 
     Raises
     ------

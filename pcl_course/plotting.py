@@ -665,20 +665,56 @@ def sampler_gallery(samples, scan_extent=((-80, 80), (-30, 30)), height_range=(-
     """
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(15, 6.5))
-    grid = fig.add_gridspec(2, len(samples), height_ratios=(2.2, 1))  # the scan's panels are flat
+    # One row per sampler, the object beside the scan: legible at the page's width.
+    fig = plt.figure(figsize=(11, 3.6 * len(samples)))
+    grid = fig.add_gridspec(len(samples), 2, width_ratios=(1, 1.6))
     for i, (name, (object_sample, scan_sample)) in enumerate(samples.items()):
-        ax = new_3d_axes(fig, grid[0, i], title=f"{name}: {len(object_sample)} points")
-        plot_cloud(ax, object_sample, size=4, axis_labels=False)
-        ax = fig.add_subplot(grid[1, i])
-        ax.scatter(*scan_sample[:, :2].T, s=0.5, c=scan_sample[:, 2], cmap="viridis", vmin=height_range[0],
+        ax = new_3d_axes(fig, grid[i, 0], title=f"{name}: {len(object_sample)} points")
+        plot_cloud(ax, object_sample, size=6, axis_labels=False)
+        ax = fig.add_subplot(grid[i, 1])
+        ax.scatter(*scan_sample[:, :2].T, s=1.5, c=scan_sample[:, 2], cmap="viridis", vmin=height_range[0],
                    vmax=height_range[1])  # fmt: skip
-        ax.set(xlim=scan_extent[0], ylim=scan_extent[1], aspect="equal", title=f"{len(scan_sample)} points",
-               xlabel="x (m)")  # fmt: skip
+        ax.set(xlim=scan_extent[0], ylim=scan_extent[1], aspect="equal", title=f"{name}: {len(scan_sample)} points",
+               xlabel="x (m)", ylabel="y (m)")  # fmt: skip
     plt.show()
 
 
-def accuracy_against_samples(published, measured_sizes, measured, chance, published_title, measured_title):
+def circle_to_ellipse(matrix, n_marked=12):
+    """The unit circle and its image under a symmetric 2x2 ``matrix``, with the eigenvectors.
+
+    Parameters
+    ----------
+    matrix : ndarray of shape (2, 2)
+        Symmetric.
+    n_marked : int
+        Points marked on the circle and joined to their images, to show
+        where each goes.
+    """
+    import matplotlib.pyplot as plt
+
+    theta = np.linspace(0, 2 * np.pi, 400)
+    circle = np.stack([np.cos(theta), np.sin(theta)])
+    image = matrix @ circle
+    values, vectors = np.linalg.eigh(matrix)
+    fig, ax = plt.subplots(figsize=(6, 6))
+    ax.plot(*circle, color="0.6", label="unit circle $x$")
+    ax.plot(*image, color="tab:blue", label="its image $Ax$")
+    marked = np.linspace(0, 2 * np.pi, n_marked, endpoint=False)
+    start = np.stack([np.cos(marked), np.sin(marked)])
+    end = matrix @ start
+    for a, b in zip(start.T, end.T):
+        ax.annotate("", b, a, arrowprops={"arrowstyle": "->", "color": "0.75", "lw": 0.8})
+    for value, vector, color in zip(values, vectors.T, ("tab:orange", "tab:red")):
+        ax.plot(*np.stack([-value * vector, value * vector]).T, color=color, lw=2.5,
+                label=f"$\\lambda = {value:.2f}$ along $u = ({vector[0]:.2f}, {vector[1]:.2f})$")  # fmt: skip
+    ax.set(aspect="equal", xlabel="$x_1$", ylabel="$x_2$")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper left", fontsize=9)
+    plt.show()
+
+
+def accuracy_against_samples(published, measured_sizes, measured, chance, published_title, measured_title,
+                             matched=None):  # fmt: skip
     """The paper's accuracies (left) beside the measured ones (right), against points per cloud.
 
     Parameters
@@ -686,25 +722,36 @@ def accuracy_against_samples(published, measured_sizes, measured, chance, publis
     published : dict of str to (array_like, array_like)
         Legend label to (points per cloud, accuracy in %).
     measured_sizes : array_like of shape (M,)
-    measured : dict of str to array_like of shape (M,)
-        Sampler to accuracy (%).
+    measured : dict of str to array_like of shape (S, M)
+        Sampler to accuracy (%) over S repetitions (seeds): drawn as the
+        mean, with the band from the lowest to the highest.
     chance : float
         Accuracy of guessing (%), drawn dashed.
+    matched : dict of str to (array_like, array_like of shape (S, K)), optional
+        Label to (points per cloud, accuracies over S seeds) of a control,
+        drawn as error bars (mean, lowest to highest) without a line.
     """
     import matplotlib.pyplot as plt
 
-    fig, (paper, ours) = plt.subplots(1, 2, figsize=(13, 4.2), sharey=True, layout="constrained")
+    fig, (paper, ours) = plt.subplots(1, 2, figsize=(10, 4.8), sharey=True, layout="constrained")
     for label, (sizes, values) in published.items():
         paper.semilogx(sizes, values, marker="o", label=label)
     paper.set(title=published_title, xlabel="points per test cloud", ylabel="accuracy (%)")
     for name, values in measured.items():
-        ours.semilogx(measured_sizes, values, marker="o", label=name)
+        values = np.atleast_2d(values)
+        (line,) = ours.semilogx(measured_sizes, values.mean(axis=0), marker="o", label=name)
+        ours.fill_between(measured_sizes, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.2)
+    for label, (sizes, values) in (matched or {}).items():
+        values = np.atleast_2d(values)
+        mean = values.mean(axis=0)
+        ours.errorbar(sizes, mean, yerr=[mean - values.min(axis=0), values.max(axis=0) - mean], fmt="s",
+                      ms=8, capsize=4, label=label)  # fmt: skip
     ours.axhline(chance, color="0.5", ls="--", label="chance")
     ours.set(title=measured_title, xlabel="points per test cloud")
     for ax in (paper, ours):
         ax.invert_xaxis()
         ax.grid(alpha=0.3, which="both")
-        ax.legend()
+        ax.legend(fontsize=9)
     plt.show()
 
 
@@ -753,17 +800,24 @@ def filtered_images(images, clean, row, columns):
     """
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(2, len(images), figsize=(16, 5.2), gridspec_kw={"height_ratios": [3, 2]}, squeeze=False,
-                          layout="constrained")  # fmt: skip
-    for ax, (label, image) in zip(axes[0], images.items()):
-        ax.imshow(image, cmap="gray", vmin=0, vmax=1.2)
-        ax.set_title(label, fontsize=9)
-        ax.axhline(row, color="tab:red", lw=0.8)
+    # Three to a row, each image above its row's profile: legible at the page's width.
+    per_row = 3
+    n_rows = -(-len(images) // per_row)
+    fig, axes = plt.subplots(2 * n_rows, per_row, figsize=(11, 5.2 * n_rows), squeeze=False, layout="constrained",
+                             gridspec_kw={"height_ratios": [3, 2] * n_rows})  # fmt: skip
+    for ax in axes.ravel():
         ax.set_axis_off()
-    for ax, image in zip(axes[1], images.values()):
-        ax.plot(clean[row], color="0.6", lw=3, label="clean")
-        ax.plot(image[row], color="tab:red", lw=1)
-        ax.set(xlim=columns, ylim=(0, 1.1), xlabel="column")
+    for i, (label, image) in enumerate(images.items()):
+        top, profile = axes[2 * (i // per_row), i % per_row], axes[2 * (i // per_row) + 1, i % per_row]
+        top.set_axis_on()
+        top.imshow(image, cmap="gray", vmin=0, vmax=1.2)
+        top.set_title(label, fontsize=11)
+        top.axhline(row, color="tab:red", lw=0.8)
+        top.set(xticks=[], yticks=[])
+        profile.set_axis_on()
+        profile.plot(clean[row], color="0.6", lw=3, label="clean")
+        profile.plot(image[row], color="tab:red", lw=1, label="filtered")
+        profile.set(xlim=columns, ylim=(0, 1.1), xlabel="column")
     axes[1, 0].legend()
     plt.show()
 

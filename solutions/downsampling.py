@@ -15,16 +15,16 @@ _FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
 
 
 def _voxel_grid(xyz, voxel_size):
-    """Grid origin (per-axis minimum, shape (3,)) and grid sizes ``D`` (a tuple of Python ints).
+    """Grid origin (per-axis minimum, shape (3,)) and grid sizes ``G`` (a tuple of Python ints).
 
-    ``D`` stays Python ints so that products of it never overflow.
+    ``G`` stays Python ints so that products of it never overflow.
     """
     lower, upper = axis_bounds(xyz)
     return lower, tuple(int(d) + 1 for d in np.floor((upper - lower) / voxel_size))
 
 
 def _voxel_coordinates(xyz, voxel_size):
-    """Per-axis voxel coordinates ``h`` (int64, shape (N, 3)) and grid sizes ``D`` (Python ints)."""
+    """Per-axis voxel coordinates ``h`` (int64, shape (N, 3)) and grid sizes ``G`` (Python ints)."""
     lower, dims = _voxel_grid(xyz, voxel_size)
     return np.floor((xyz - lower) / voxel_size).astype(np.int64), dims
 
@@ -32,7 +32,7 @@ def _voxel_coordinates(xyz, voxel_size):
 def _group_sorted(h):
     """Group ids ordered by linear index, by sorting the coordinates lexicographically.
 
-    Ordering by the linear index ``h_x + h_y D_x + h_z D_x D_y`` is ordering
+    Ordering by the linear index ``h_x + h_y G_x + h_z G_x G_y`` is ordering
     by ``(h_z, h_y, h_x)``: exact for any grid size, where the linear index
     itself may overflow int64. The slow path, for grids of more than 2^63 cells.
     """
@@ -107,7 +107,7 @@ def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
 
     Notes
     -----
-    Must stay correct when ``D_x * D_y * D_z`` does not fit in int64: never
+    Must stay correct when ``G_x * G_y * G_z`` does not fit in int64: never
     merge two distinct voxels.
 
     Examples
@@ -133,7 +133,7 @@ def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):
 
 
 def _linear_index_modulo(h, dx, dy, m):
-    """``(h_x + h_y D_x + h_z D_x D_y) % m`` exactly, for a linear index beyond int64."""
+    """``(h_x + h_y G_x + h_z G_x G_y) % m`` exactly, for a linear index beyond int64."""
     if m < 2**31:  # term by term: every product of two residues stays below 2^62
         return (h[:, 0] % m + (h[:, 1] % m) * (dx % m) % m + (h[:, 2] % m) * ((dx * dy) % m) % m) % m
     # Residues near 2^63 would overflow their products: Python integers (rare, slow),

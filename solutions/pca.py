@@ -224,7 +224,11 @@ def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
     alphas : ndarray of float64, shape (N, n_components)
         The matching eigenvectors, scaled so that
         ``alphas[:, r] @ alphas[:, r] == 1 / eigenvalues[r]``.
-        The sign of each component is free.
+        The sign of each component is free. An eigenvalue that is zero has
+        no such scaling: its column is all zeros (and its projections are
+        0). ``K~`` always has one (the constant vector), and more when N
+        exceeds the dimension of the feature space; numerically, "zero" is
+        at most ``1e-12`` times the largest eigenvalue, as in scikit-learn.
 
     Raises
     ------
@@ -242,12 +246,13 @@ def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):
     n_components = check_integer(n_components, "n_components", low=1, high=n)
     gram = _self_gram(points, kernel, beta, degree)
     eigenvalues, eigenvectors = _top_eigenpairs(gram, n_components)
-    positive = eigenvalues > 0
+    # Zero eigenvalues (to round-off, as scikit-learn's _check_psd_eigenvalues decides) get zero alphas.
+    positive = eigenvalues > 1e-12 * max(eigenvalues[0], 0.0)
     scale = np.zeros_like(eigenvalues)
     scale[positive] = 1.0 / np.sqrt(eigenvalues[positive])
     alphas = eigenvectors * scale
     # K~ alphas = K~ v / sqrt(l) = sqrt(l) v: no N x N product needed.
-    projections = eigenvectors * np.sqrt(np.clip(eigenvalues, 0.0, None))
+    projections = eigenvectors * np.sqrt(np.where(positive, eigenvalues, 0.0))
     return projections, np.ascontiguousarray(eigenvalues), np.ascontiguousarray(alphas)
 
 

@@ -1,4 +1,4 @@
-"""Degenerate answers, generated for every graded function (issue 17).
+"""Degenerate answers, generated for every graded function.
 
 Each wraps the reference, so that it raises what the reference raises, and
 then throws the answer away:

@@ -2,7 +2,7 @@
 
 Each is the straightforward reading of ``course-api.md``: NumPy, SciPy's
 k-d tree and LAPACK, Python loops where the algorithm is sequential. They
-were the references before issue 8 made those fast; tests/project/
+were the references before their fast paths were written; tests/project/
 test_fast_paths.py checks that the fast ones still give the same answers.
 """
 

@@ -1,6 +1,6 @@
 """Dishonest submissions, through the real grader (``python -m grading grade``).
 
-One test per class of attack of issue 17, each with payloads of our own: a
+One test per class of attack on the grader, each with payloads of our own: a
 forged or stolen mark must come out as 0 and the submission must learn
 nothing of the grader's files, of other submissions or of the network. Where
 it applies, the grader runs both as root (dropping to a dedicated uid) and

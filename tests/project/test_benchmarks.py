@@ -97,7 +97,7 @@ def test_committed_results_cover_every_target():
     results = json.loads(RESULTS.read_text())
     measured = {c["case"]: c for c in results["cases"]}
     targets = [case for case in all_cases() if case.target]
-    assert len(targets) >= 6 * 3  # six targets of issue 8, on each of the three clouds (kernel PCA on two)
+    assert len(targets) >= 6 * 3  # six performance targets, on each of the three clouds (kernel PCA on two)
     for case in targets:
         assert case.id in measured, f"{case.id} missing from {RESULTS.name}: run make bench"
         entry = measured[case.id]

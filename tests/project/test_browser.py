@@ -81,6 +81,25 @@ def test_page_in_a_real_browser(name, site, browser):
         tab.evaluate("MathJax.startup.promise")
         assert tab.locator("mjx-container").count() > 0, f"{name}: math was not typeset"
 
+    # Nothing is cut at 1280 px: every table fits the text column, and every display
+    # equation fits its line (none needs the scroll bar the CSS gives as a last resort).
+    cut = tab.evaluate(
+        """() => {
+        const cut = [];
+        const column = document.querySelector('article').getBoundingClientRect();
+        for (const table of document.querySelectorAll('article table')) {
+            const box = table.getBoundingClientRect();
+            if (box.right > column.right + 1 || table.parentElement.scrollWidth > table.parentElement.clientWidth + 1)
+                cut.push('table: ' + table.innerText.slice(0, 50));
+        }
+        for (const equation of document.querySelectorAll('mjx-container[display="true"]')) {
+            const box = equation.getBoundingClientRect();
+            if (box.right > column.right + 1 || equation.scrollWidth > equation.clientWidth + 1)
+                cut.push('equation: ' + (equation.getAttribute('aria-label') || equation.textContent).slice(0, 50));
+        }
+        return cut;
+    }"""
+    )
     figures = html.count('class="plotly-graph-div"')
     if figures:
         tab.wait_for_function(f"document.querySelectorAll('.js-plotly-plot canvas').length >= {figures}", timeout=30000)
@@ -90,6 +109,7 @@ def test_page_in_a_real_browser(name, site, browser):
     tab.screenshot(path=str(SCREENSHOTS / (re.sub(r"\W", "_", name) + ".png")))
     tab.close()
     assert not errors, f"{name}: console errors {errors}"
+    assert not cut, f"{name}: cut at 1280 px: {cut}"
     assert not remote, f"{name}: requests off this machine {remote[:3]}"
 
 
@@ -99,6 +119,8 @@ def test_long_code_lines_wrap_and_legends_clear_the_mode_bar(site, browser):
     tab.wait_for_function("document.querySelectorAll('.js-plotly-plot .legend').length > 0", timeout=30000)
     code = tab.locator("div.cell_input pre").first
     assert code.evaluate("e => getComputedStyle(e).whiteSpace") == "pre-wrap"
+    output = tab.locator("div.cell_output pre").first
+    assert output.evaluate("e => getComputedStyle(e).whiteSpace") == "pre", "printed tables must not wrap"
     assert code.evaluate("e => e.scrollWidth <= e.clientWidth + 1"), "a code cell scrolls sideways: its lines are cut"
     plot = tab.locator(".js-plotly-plot").first
     plot.hover()  # the mode bar shows on hover

@@ -188,6 +188,26 @@ def test_lidar_ground_points_lie_on_the_ground_plane(scan):
     assert np.allclose(scan.normals[ground], [0, 0, 1], atol=1e-6)
 
 
+def test_lidar_ground_density_falls_as_the_cube_of_the_range(scan):
+    # book/point_clouds.md, prop-lidar-density: each beam at depression theta meets the ground at
+    # r = h / tan(theta), so the circles spread as r^2 and the density falls as r^-3, not r^-2.
+    ground = (scan.labels == datasets.LIDAR_CLASSES.index("ground")) & ~scan.is_outlier
+    elevations = np.deg2rad(np.linspace(2.0, -24.8, 64))
+    ranges = np.linalg.norm(scan.points[ground, :2], axis=1)
+    predicted = datasets.SENSOR_HEIGHT / np.tan(-elevations[scan.ring[ground]])
+    assert np.median(np.abs(ranges / predicted - 1)) < 0.01
+    # One annulus per beam's circle, from the circle halfway in to halfway out.
+    circles = np.sort(datasets.SENSOR_HEIGHT / np.tan(-elevations[elevations < 0]))
+    middle = circles[1:-1]
+    areas = np.pi * (((circles[2:] + middle) / 2) ** 2 - ((circles[:-2] + middle) / 2) ** 2)
+    returns = np.histogram(ranges, bins=(circles[1:] + circles[:-1]) / 2)[0]
+    chosen = (middle >= 10) & (middle <= 60) & (returns > 0)
+    model_exponent = np.polyfit(np.log(middle[chosen]), np.log(1 / areas[chosen]), 1)[0]
+    scan_exponent = np.polyfit(np.log(middle[chosen]), np.log(returns[chosen] / areas[chosen]), 1)[0]
+    assert -3.2 < model_exponent < -2.8
+    assert scan_exponent < model_exponent  # occlusion: far circles reach the ground at fewer azimuths
+
+
 def test_lidar_normals_face_the_sensor(scan):
     inliers = ~scan.is_outlier
     facing = np.sum(scan.normals[inliers] * (scan.origin - scan.points[inliers]), axis=1)

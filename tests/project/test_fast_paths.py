@@ -1,4 +1,4 @@
-"""The references' fast paths (issue 8) give the answers of the plain implementations.
+"""The references' fast paths give the answers of the plain implementations.
 
 The graded tests check the references against the contract; these check
 each optimisation where it could go wrong: the bucket-pruned farthest point

@@ -1,4 +1,4 @@
-"""What a submission can put in front of a student or an instructor (issue 24).
+"""What a submission can put in front of a student or an instructor.
 
 * Feedback is sanitised: no terminal escape, HTML or Markdown of a
   submission's reaches the results file or the terminal as anything but

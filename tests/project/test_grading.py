@@ -169,7 +169,7 @@ def declared_mistake(path):
     raise AssertionError(f"{path.relative_to(REPO_ROOT)} declares no MISTAKE (its diagnosis, or None)")
 
 
-DIAGNOSIS_FLOOR = 0.9  # of the mutants, named by their diagnosis (issue 13)
+DIAGNOSIS_FLOOR = 0.9  # of the mutants, named by their diagnosis
 
 
 @pytest.mark.parametrize("mutant", MUTANTS, ids=ids(MUTANTS))

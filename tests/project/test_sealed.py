@@ -1,4 +1,4 @@
-"""A sealed grade (issue 24): each class of attack, with payloads of our own.
+"""A sealed grade: each class of attack, with payloads of our own.
 
 * frozen inputs: a call that rewrites its arguments never raises a score,
   and a random generator comes back only in a state its own stream reaches;
