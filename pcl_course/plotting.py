@@ -696,7 +696,7 @@ def circle_to_ellipse(matrix, n_marked=12):
     circle = np.stack([np.cos(theta), np.sin(theta)])
     image = matrix @ circle
     values, vectors = np.linalg.eigh(matrix)
-    fig, ax = plt.subplots(figsize=(6, 6))
+    fig, ax = plt.subplots(figsize=(7, 6.5))
     ax.plot(*circle, color="0.6", label="unit circle $x$")
     ax.plot(*image, color="tab:blue", label="its image $Ax$")
     marked = np.linspace(0, 2 * np.pi, n_marked, endpoint=False)
@@ -709,7 +709,7 @@ def circle_to_ellipse(matrix, n_marked=12):
                 label=f"$\\lambda = {value:.2f}$ along $u = ({vector[0]:.2f}, {vector[1]:.2f})$")  # fmt: skip
     ax.set(aspect="equal", xlabel="$x_1$", ylabel="$x_2$")
     ax.grid(alpha=0.3)
-    ax.legend(loc="upper left", fontsize=9)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), fontsize=9, ncol=2)
     plt.show()
 
 
@@ -728,30 +728,35 @@ def accuracy_against_samples(published, measured_sizes, measured, chance, publis
     chance : float
         Accuracy of guessing (%), drawn dashed.
     matched : dict of str to (array_like, array_like of shape (S, K)), optional
-        Label to (points per cloud, accuracies over S seeds) of a control,
-        drawn as error bars (mean, lowest to highest) without a line.
+        Sampler (a key of ``measured``) to (points per cloud, accuracies over
+        S seeds) of the control trained on that sampler's samples: squares
+        in the sampler's colour with error bars (mean, lowest to highest).
     """
     import matplotlib.pyplot as plt
 
-    fig, (paper, ours) = plt.subplots(1, 2, figsize=(10, 4.8), sharey=True, layout="constrained")
+    fig, (paper, ours) = plt.subplots(1, 2, figsize=(11, 4.8), sharey=True, layout="constrained")
     for label, (sizes, values) in published.items():
         paper.semilogx(sizes, values, marker="o", label=label)
     paper.set(title=published_title, xlabel="points per test cloud", ylabel="accuracy (%)")
+    colours = {}
     for name, values in measured.items():
         values = np.atleast_2d(values)
-        (line,) = ours.semilogx(measured_sizes, values.mean(axis=0), marker="o", label=name)
+        (line,) = ours.semilogx(measured_sizes, values.mean(axis=0), marker="o", label=f"{name}, trained on full")
         ours.fill_between(measured_sizes, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.2)
-    for label, (sizes, values) in (matched or {}).items():
+        colours[name] = line.get_color()
+    for name, (sizes, values) in (matched or {}).items():
         values = np.atleast_2d(values)
         mean = values.mean(axis=0)
-        ours.errorbar(sizes, mean, yerr=[mean - values.min(axis=0), values.max(axis=0) - mean], fmt="s",
-                      ms=8, capsize=4, label=label)  # fmt: skip
+        spread = [mean - values.min(axis=0), values.max(axis=0) - mean]
+        ours.errorbar(sizes, mean, yerr=spread, fmt="s", ms=8, capsize=4, color=colours.get(name), mec="black",
+                      label=f"{name}, trained on {name} samples")  # fmt: skip
     ours.axhline(chance, color="0.5", ls="--", label="chance")
     ours.set(title=measured_title, xlabel="points per test cloud")
     for ax in (paper, ours):
         ax.invert_xaxis()
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=9)
+    paper.legend(loc="lower left")
+    ours.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), fontsize=9)
     plt.show()
 
 

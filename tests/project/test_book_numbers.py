@@ -73,6 +73,7 @@ def stated_numbers(text):
     prose = re.sub(r"^```.*?^```", "", prose, flags=re.S | re.M)  # other fenced blocks
     prose = re.sub(r"\{glue:[a-z]*\}`[^`]*`", "", prose)
     prose = re.sub(r"`[^`]*`", "", prose)  # inline code
+    prose = re.sub(r"^:[\w-]+:.*$", "", prose, flags=re.M)  # a directive's options (:widths: 20 65 15)
     prose = re.sub(r"\]\([^)]*\)", "]", prose)  # link targets
     prose = re.sub(r"[^.\n]*(?:\n[^.\n]+)*\{cite\}[^.]*\.", "", prose)  # a sentence that cites its source
     prose = EXERCISE_POINTS.sub("", prose)
