@@ -87,3 +87,22 @@ def test_the_point_bilateral_worked_example_moves_p_by_the_stated_fraction():
         moved = bilateral_filter_points(trio, up, radius=1.5, sigma_s=sigma_s, sigma_r=sigma_r)[0]
         assert np.allclose(moved, [0.0, 0.0, 0.2 * w / (1 + 2 * w)], atol=1e-12)
         assert moved[2] < 0.1
+
+
+def test_farthest_point_sampling_covers_within_twice_the_best_radius():
+    # book/downsampling.md, thm-fps-two, against brute force over centres among the points
+    from itertools import combinations
+
+    from scipy.spatial.distance import cdist
+
+    from solutions.downsampling import farthest_point_sampling
+
+    rng = np.random.default_rng(6)
+    for _ in range(5):
+        points = np.column_stack([rng.uniform(size=(16, 2)), np.zeros(16)])
+        distances = cdist(points, points)
+        for m in (2, 3):
+            start = int(rng.integers(16))
+            fps = distances[:, farthest_point_sampling(points, m, start_index=start)].min(axis=1).max()
+            best = min(distances[:, list(c)].min(axis=1).max() for c in combinations(range(16), m))
+            assert fps <= 2 * best + 1e-12
