@@ -734,6 +734,7 @@ class Worker:
         self.uid = self.isolation.uid
         self.broken = {}  # module -> why it cannot be imported
         self.last_modified = []
+        self.known_pids = None  # the worker's processes at the last count (None: not counted yet)
         if self.uid is not None:
             remove_files_of(self.uid)  # what an earlier grader, killed, may have left
 
@@ -773,6 +774,7 @@ class Worker:
         if self.uid is not None:
             os.chown(self.work, self.uid, self.uid)
         command, env = self._command()
+        self.known_pids = None  # a restarted worker's processes are new
         self.stderr = tempfile.TemporaryFile()
         self.process = _spawn(
             command,
@@ -1049,7 +1051,7 @@ class _Deadline:
     def __post_init__(self):
         # Between calls the worker runs exactly the processes counted after the last one (any more
         # would have stopped it): no need to walk /proc again here, the hot path of every call.
-        self.cpu_start = self.worker.cpu_seconds(getattr(self.worker, "known_pids", None))
+        self.cpu_start = self.worker.cpu_seconds(self.worker.known_pids)
         self.wall_seconds = self.cpu_seconds * config.CALL_WALL_FACTOR
         self.wall = time.monotonic() + self.wall_seconds
 

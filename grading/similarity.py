@@ -202,8 +202,8 @@ def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
 <html lang="en"><head><meta charset="utf-8"><title>Similarity report</title>
 <style>{STYLE}</style></head><body>
 <h1>Similarity of the exercise modules</h1>
-<p>{counted(len(pairs), "pair")} share code beyond the stubs; {len(shown)} reach{"es" if len(shown) == 1 else ""} \
-{threshold:.0%} of a file and {"is" if len(shown) == 1 else "are"} shown.
+<p>{counted(len(pairs), "pair")} share{"s" if len(pairs) == 1 else ""} code beyond the stubs; {len(shown)} \
+reach{"es" if len(shown) == 1 else ""} {threshold:.0%} of a file and {"is" if len(shown) == 1 else "are"} shown.
 The share is the part of a student's file (stub text removed, names folded) that the other file holds too.
 A high share is a reason to read both files, not a verdict.</p>
 {f"<ul>{notes}</ul>" if notes else ""}

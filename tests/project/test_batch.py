@@ -1,5 +1,6 @@
 """Batch mode: a folder of submissions graded in parallel, marks in a CSV."""
 
+import csv
 import shutil
 
 from _helpers import run_batch
@@ -38,21 +39,12 @@ def test_batch_grades_every_submission_and_writes_a_csv(tmp_path):
     assert (tmp_path / "class-results" / "alice.json").is_file()
 
 
-def test_batch_writes_a_canvas_gradebook_matched_to_the_roster(tmp_path):
-    classroom = tmp_path / "class"
-    make_submission(classroom, "alice01", [REPO_ROOT / "solutions" / "metrics.py"])
-    make_submission(classroom, "bob02", [])
-    make_submission(classroom, "zed99", [])  # not on the roster
+def batch_with_gradebook(classroom, tmp_path, roster_text, assignment):
+    """Grade ``classroom`` (Chamfer tests only) with a Canvas roster: marks.csv's rows and the gradebook's."""
     roster = tmp_path / "export.csv"
-    roster.write_text(
-        "Student,ID,SIS User ID,SIS Login ID,Section,Homework 0 (41)\n"
-        "    Points Possible,,,,,10\n"
-        '"Liddell, Alice",101,S-1,alice01,Sec A,7\n'
-        '"Builder, Bob",102,S-2,bob02,Sec A,9\n'
-        '"Late, Carol",103,S-3,carol03,Sec B,\n'
-    )
+    roster.write_text(roster_text)
     gradebook = tmp_path / "canvas.csv"
-    run_batch(
+    rows = run_batch(
         classroom,
         tmp_path / "marks.csv",
         "-k",
@@ -60,14 +52,29 @@ def test_batch_writes_a_canvas_gradebook_matched_to_the_roster(tmp_path):
         "--gradebook",
         str(gradebook),
         "--assignment",
-        "Lecture 1 (123)",
+        assignment,
         "--roster",
         str(roster),
     )
-    import csv
-
     with open(gradebook, newline="") as handle:
-        rows = list(csv.reader(handle))
+        return rows, list(csv.reader(handle))
+
+
+def test_batch_writes_a_canvas_gradebook_matched_to_the_roster(tmp_path):
+    classroom = tmp_path / "class"
+    make_submission(classroom, "alice01", [REPO_ROOT / "solutions" / "metrics.py"])
+    make_submission(classroom, "bob02", [])
+    make_submission(classroom, "zed99", [])  # not on the roster
+    _, rows = batch_with_gradebook(
+        classroom,
+        tmp_path,
+        "Student,ID,SIS User ID,SIS Login ID,Section,Homework 0 (41)\n"
+        "    Points Possible,,,,,10\n"
+        '"Liddell, Alice",101,S-1,alice01,Sec A,7\n'
+        '"Builder, Bob",102,S-2,bob02,Sec A,9\n'
+        '"Late, Carol",103,S-3,carol03,Sec B,\n',
+        "Lecture 1 (123)",
+    )
     assert rows[0] == ["Student", "ID", "SIS User ID", "SIS Login ID", "Section", "Lecture 1 (123)"]
     assert rows[1][0] == "Points Possible" and float(rows[1][5]) > 0
     assert rows[2] == ["Liddell, Alice", "101", "S-1", "alice01", "Sec A", rows[1][5]]  # full marks
@@ -105,24 +112,13 @@ def test_batch_accounts_for_every_folder_in_five_layouts(tmp_path):
     refused = make_submission(classroom, "eve05", [])  # a link out of the submission: refused
     (refused / "metrics.py").unlink()
     (refused / "metrics.py").symlink_to("/etc/passwd")
-    roster = tmp_path / "export.csv"
-    roster.write_text(
+    rows, gradebook = batch_with_gradebook(
+        classroom,
+        tmp_path,
         "Student,ID,SIS User ID,SIS Login ID,Section\n"
         "    Points Possible,,,,\n"
         + "".join(f"S{i},{100 + i},S-{i},{login},A\n" for i, login in enumerate(["alice01", "empty02", "loose03"], 1))
-        + "Dana Scully,104,S-4,dana04,A\nEve,105,S-5,eve05,A\nFrank,106,S-6,frank06,A\n"
-    )
-    gradebook = tmp_path / "canvas.csv"
-    rows = run_batch(
-        classroom,
-        tmp_path / "marks.csv",
-        "-k",
-        "test_chamfer_distance_",
-        "--gradebook",
-        str(gradebook),
-        "--roster",
-        str(roster),
-        "--assignment",
+        + "Dana Scully,104,S-4,dana04,A\nEve,105,S-5,eve05,A\nFrank,106,S-6,frank06,A\n",
         "L1",
     )
     assert set(rows) == {"alice01", "empty02", "loose03", "submission_31415926", "eve05"}
@@ -136,10 +132,7 @@ def test_batch_accounts_for_every_folder_in_five_layouts(tmp_path):
     assert rows["submission_31415926"]["score"] == full
     assert rows["submission_31415926"]["submitters"] == "Dana Scully <dana04@example.edu> S-4"
     assert rows["eve05"]["status"] == "not graded" and rows["eve05"]["note"].startswith("refused:")
-    import csv
-
-    with open(gradebook, newline="") as handle:
-        marks = {row["SIS Login ID"]: row["L1"] for row in csv.DictReader(handle)}
+    marks = {row[3]: row[5] for row in gradebook[1:]}  # SIS Login ID -> the L1 column
     # Dana is matched through the metadata's SID; Frank has no folder: no change on import.
     assert marks == {
         "": marks[""],  # the Points Possible row
