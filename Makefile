@@ -7,10 +7,11 @@
 #   make grade SUBMISSION=dir    grade a student's clone
 #   make requirements   re-pin requirements/ (the lock and its two subsets)
 #   make bench    time the references against Open3D, scikit-learn and fpsample
-#   make gradescope   write the Gradescope autograder archive (GRADESCOPE_ZIP)
+#   make gradescope   write the Gradescope autograder archive of ASSIGNMENT (lecture1, lecture2)
 SUBMISSION ?=
 RESULTS ?= results/results.json
-GRADESCOPE_ZIP ?= _build/gradescope/autograder.zip
+ASSIGNMENT ?= lecture1
+GRADESCOPE_ZIP ?= _build/gradescope/autograder-$(ASSIGNMENT).zip
 
 include scripts/setup.mk
 
@@ -55,11 +56,12 @@ grade: setup
 	@test -n "$(SUBMISSION)" || { echo "usage: make grade SUBMISSION=path/to/student/clone"; exit 2; }
 	$(BIN)/python -m grading grade "$(SUBMISSION)" --results "$(RESULTS)"
 
-# The archive instructors upload to Gradescope as the assignment's autograder:
+# The archive instructors upload to Gradescope as an assignment's autograder,
+# one per lecture (ASSIGNMENT=lecture1 or lecture2, grading.config.ASSIGNMENTS):
 # grader, stubs, public and hidden tests, setup.sh and run_autograder; no
 # solutions (it is scanned for them). README "Running a class".
 gradescope: setup
-	$(BIN)/python -m grading gradescope "$(GRADESCOPE_ZIP)"
+	$(BIN)/python -m grading gradescope "$(GRADESCOPE_ZIP)" --assignment $(ASSIGNMENT)
 
 # Benchmarks (benchmarks/README.md): pytest-benchmark, serial (no xdist: the
 # implementations use both cores), no per-test timeout. The summary, committed,

@@ -29,4 +29,10 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 GRADED_TESTS = REPO_ROOT / "tests" / "graded"  # public: shipped to students
 HIDDEN_TESTS = REPO_ROOT / "tests" / "hidden"  # run only by the instructors' grader
 
-from grading.config import EXERCISE_MODULES, GRADED_FUNCTIONS, HELPER_MODULES  # noqa: E402,F401
+from grading.config import (  # noqa: E402,F401
+    ASSIGNMENT_MODULES,
+    ASSIGNMENTS,
+    EXERCISE_MODULES,
+    GRADED_FUNCTIONS,
+    HELPER_MODULES,
+)

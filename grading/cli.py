@@ -43,7 +43,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT, config
+from grading import ASSIGNMENTS, REPO_ROOT, config
 from grading.results import Grading
 from grading.runner import PYTEST_EXIT_NO_TESTS, PYTEST_EXIT_USAGE, run_graded_tests
 
@@ -88,7 +88,7 @@ def grade(args):
         sandbox=sandbox,
         call_timeout=args.call_timeout,
         require_isolation=args.require_isolation,
-        functions=args.function,
+        functions=[*args.function, *ASSIGNMENTS.get(args.assignment, ())],
         budget=args.budget,
         diagnose_always=args.diagnose_always,
     )
@@ -269,7 +269,7 @@ def batch(args):
         # Laid over the course's stubs as on Gradescope: a whole clone, its pcl_course/, or loose modules.
         with tempfile.TemporaryDirectory(prefix="batch-", dir=out) as work:
             try:
-                package, folder.note = assemble(entry, work)
+                package, folder.note = assemble(entry, work, args.assignment)
             except StagingError as exc:
                 folder.status, folder.note = "not graded", f"refused: {exc}"
                 return folder, ""
@@ -277,7 +277,14 @@ def batch(args):
             uid = slots.get()
             try:
                 code, output = run_graded_tests(
-                    package, results, args.k, sandbox=True, require_isolation=require, sandbox_uid=uid, note=folder.note
+                    package,
+                    results,
+                    args.k,
+                    sandbox=True,
+                    require_isolation=require,
+                    sandbox_uid=uid,
+                    note=folder.note,
+                    functions=list(ASSIGNMENTS[args.assignment]),
                 )
             finally:
                 slots.put(uid)
@@ -292,7 +299,9 @@ def batch(args):
         graded = list(pool.map(grade_one, entries))
     folders = [folder for folder, _ in graded]
 
-    functions = [f for f in GRADED_FUNCTIONS if any(d.grading and f in d.grading.per_function() for d in folders)]
+    functions = [
+        f for f in ASSIGNMENTS[args.assignment] if any(d.grading and f in d.grading.per_function() for d in folders)
+    ]
     csv_path = Path(args.csv) if args.csv else out / "marks.csv"
     with open(csv_path, "w", newline="") as handle:
         writer = csv.writer(handle)
@@ -379,6 +388,11 @@ def main(argv=None):
         help="grade only this function's tests (by their grades marker); repeatable",
     )
     g.add_argument(
+        "--assignment",
+        choices=sorted(ASSIGNMENTS),
+        help="grade only this assignment's functions (one per lecture; default: every graded function)",
+    )
+    g.add_argument(
         "--call-timeout",
         type=float,
         help=f"CPU seconds one call of a submission may take (default {config.CALL_TIMEOUT:g})",
@@ -399,6 +413,12 @@ def main(argv=None):
         "directory",
         help="a folder with one submission per subdirectory (a clone, its pcl_course/, or loose modules), "
         "or Gradescope's exported submissions with their submission_metadata.yml",
+    )
+    b.add_argument(
+        "--assignment",
+        required=True,
+        choices=sorted(ASSIGNMENTS),
+        help="the assignment to grade (one per lecture): its functions make the total",
     )
     b.add_argument("--csv", help="where to write the marks (default: OUT/marks.csv)")
     b.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
@@ -438,12 +458,19 @@ def main(argv=None):
     )
     s.add_argument("--top", type=int, default=100, help="show at most this many pairs (default 100)")
     z = commands.add_parser("gradescope", help="write the Gradescope autograder archive (no solutions)")
-    z.add_argument("out_zip", help="the .zip to write, e.g. _build/gradescope/autograder.zip")
+    z.add_argument("out_zip", help="the .zip to write, e.g. _build/gradescope/autograder-lecture1.zip")
+    z.add_argument(
+        "--assignment",
+        required=True,
+        choices=sorted(ASSIGNMENTS),
+        help="the Gradescope assignment this archive grades (one per lecture)",
+    )
     a = commands.add_parser(
         "autograde", help="inside a Gradescope container: grade ROOT/submission into ROOT/results/results.json"
     )
     a.add_argument("--root", default="/autograder", help="the autograder folder (default /autograder)")
     a.add_argument("--budget", type=float, metavar="SECONDS", help=argparse.SUPPRESS)
+    a.add_argument("--assignment", required=True, choices=sorted(ASSIGNMENTS), help="the assignment graded")
     args = parser.parse_args(argv)
     module = INSTRUCTOR_COMMANDS.get(args.command)
     if module and importlib.util.find_spec(module) is None:
@@ -454,16 +481,19 @@ def main(argv=None):
     if args.command == "gradescope":
         from grading.gradescope import build_archive
 
-        leaks = build_archive(args.out_zip)
+        leaks = build_archive(args.out_zip, args.assignment)
         if leaks:
             print("error: the archive would contain reference code:\n" + "\n".join(leaks[:20]), file=sys.stderr)
             return 1
-        print(f"Gradescope autograder written to {args.out_zip}: upload it as the assignment's autograder")
+        print(
+            f"Gradescope autograder of {args.assignment} written to {args.out_zip}: "
+            "upload it as that assignment's autograder"
+        )
         return 0
     if args.command == "autograde":
         from grading.gradescope import autograde
 
-        return autograde(args.root, args.budget)
+        return autograde(args.root, args.budget, args.assignment)
     if args.command == "release":
         from grading.release import release
 

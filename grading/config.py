@@ -7,27 +7,44 @@ modules of :mod:`grading` import them from this module.
 import os
 
 # -- what is graded -------------------------------------------------------------
-# Graded function -> exercise module; every name in ../shared/course-api.md.
-GRADED_FUNCTIONS = {
-    "pca": "pca",
-    "kernel_matrix": "pca",
-    "kernel_pca": "pca",
-    "kernel_pca_transform": "pca",
-    "fit_plane": "normals",
-    "estimate_normals": "normals",
-    "voxel_grid_downsample": "downsampling",
-    "approximate_voxel_downsample": "downsampling",
-    "farthest_point_sampling": "downsampling",
-    "normal_space_sampling": "downsampling",
-    "radius_outlier_removal": "filters",
-    "statistical_outlier_removal": "filters",
-    "bilateral_filter_image": "filters",
-    "bilateral_filter_points": "filters",
-    "joint_bilateral_upsample": "filters",
-    "chamfer_distance": "metrics",
-    "depth_metrics": "metrics",
+# One assignment per lecture, each its own Gradescope assignment (its own
+# archive and total): graded function -> exercise module, every name in
+# ../shared/course-api.md (lecture 1) or in pcl_course/nn.py's contract (lecture 2).
+ASSIGNMENTS = {
+    "lecture1": {
+        "pca": "pca",
+        "kernel_matrix": "pca",
+        "kernel_pca": "pca",
+        "kernel_pca_transform": "pca",
+        "fit_plane": "normals",
+        "estimate_normals": "normals",
+        "voxel_grid_downsample": "downsampling",
+        "approximate_voxel_downsample": "downsampling",
+        "farthest_point_sampling": "downsampling",
+        "normal_space_sampling": "downsampling",
+        "radius_outlier_removal": "filters",
+        "statistical_outlier_removal": "filters",
+        "bilateral_filter_image": "filters",
+        "bilateral_filter_points": "filters",
+        "joint_bilateral_upsample": "filters",
+        "chamfer_distance": "metrics",
+        "depth_metrics": "metrics",
+    },
+    "lecture2": {
+        "knn_result_set": "nn",
+        "bst_build": "nn",
+        "bst_knn": "nn",
+        "kdtree_build": "nn",
+        "kdtree_knn": "nn",
+        "kdtree_radius": "nn",
+        "octree_build": "nn",
+        "octree_radius": "nn",
+        "octree_knn": "nn",
+    },
 }
+GRADED_FUNCTIONS = {function: module for graded in ASSIGNMENTS.values() for function, module in graded.items()}
 EXERCISE_MODULES = tuple(dict.fromkeys(GRADED_FUNCTIONS.values()))  # pcl_course/<module>.py
+ASSIGNMENT_MODULES = {name: tuple(dict.fromkeys(graded.values())) for name, graded in ASSIGNMENTS.items()}
 # Complete helper modules of pcl_course: they may use Open3D (data sets) and
 # are not exercises. A submission's copy is trusted only if it is unchanged.
 HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")
@@ -87,3 +104,21 @@ STAGE_SKIPPED_NAMES = ("__pycache__", ".ipynb_checkpoints", ".DS_Store")
 
 # -- what submissions may not use (grading/forbidden.py) -----------------------
 FORBIDDEN_PACKAGES = ("open3d", "sklearn", "pcl", "pclpy", "torch", "torch_cluster", "pytorch3d", "fpsample")
+# Forbidden in one exercise module only, by dotted prefix ("pcl_course.x": the
+# package's own module x, however it is imported). The nearest-neighbour
+# lecture is about writing the search: no library's, nor the course's own
+# helper (lecture 1 may use both).
+FORBIDDEN_IN_MODULE = {
+    "nn": (
+        "scipy.spatial",
+        "pykdtree",
+        "pynanoflann",
+        "faiss",
+        "hnswlib",
+        "annoy",
+        "nanoflann",
+        "numba_kdtree",
+        "kdtree",
+        "pcl_course.neighbors",
+    ),
+}

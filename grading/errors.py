@@ -4,6 +4,8 @@ Each carries a message written for the student: one line that says what went
 wrong and, where it can, what to do.
 """
 
+from grading.config import FORBIDDEN_IN_MODULE
+
 
 class SandboxError(Exception):
     """The worker failed: a timeout, a crash, a module that cannot be imported,
@@ -59,10 +61,11 @@ class ForbiddenAPI(Exception):
 
     def __init__(self, module, violations):
         shown = "; ".join(str(v) for v in violations[:3])
-        super().__init__(
-            f"forbidden API in {module}.py ({shown}): write your own code; Open3D, PCL and "
-            "scikit-learn are allowed for visualisation only, outside the exercise modules"
-        )
+        if module in FORBIDDEN_IN_MODULE:
+            why = "this lecture is about writing the search: no library's neighbour search, nor pcl_course.neighbors"
+        else:
+            why = "Open3D, PCL and scikit-learn are allowed for visualisation only, outside the exercise modules"
+        super().__init__(f"forbidden API in {module}.py ({shown}): write your own code; {why}")
 
 
 class DidNotRaise(CheckFailed):

@@ -14,7 +14,7 @@ import ast
 from dataclasses import dataclass
 from pathlib import Path
 
-from grading.config import FORBIDDEN_PACKAGES, HELPER_MODULES
+from grading.config import FORBIDDEN_IN_MODULE, FORBIDDEN_PACKAGES, HELPER_MODULES
 
 IMPORT_FUNCTIONS = {("builtins", "__import__"), ("importlib", "import_module"), ("importlib", "__import__")}
 
@@ -29,9 +29,28 @@ class Violation:
         return f"{Path(self.path).name}:{self.line}: {self.what}"
 
 
-def _forbidden(module_name):
-    root = (module_name or "").split(".")[0]
-    return root if root in FORBIDDEN_PACKAGES else None
+def _forbidden(module_name, extra=()):
+    """The forbidden package or module that ``module_name`` (dotted) is or lies in, else None.
+
+    ``extra``: dotted names forbidden on top of :data:`FORBIDDEN_PACKAGES`
+    (one exercise module's, :data:`FORBIDDEN_IN_MODULE`).
+    """
+    name = module_name or ""
+    root = name.split(".")[0]
+    if root in FORBIDDEN_PACKAGES:
+        return root
+    return next((banned for banned in extra if name == banned or name.startswith(banned + ".")), None)
+
+
+def _dotted(node):
+    """``a.b.c`` for an attribute chain on a plain name, else None."""
+    parts = []
+    while isinstance(node, ast.Attribute):
+        parts.append(node.attr)
+        node = node.value
+    if not isinstance(node, ast.Name):
+        return None
+    return ".".join([node.id, *reversed(parts)])
 
 
 def _literal_string(node):
@@ -57,40 +76,69 @@ def _call_name(node, aliases):
     return None
 
 
-def scan_source(source, path="<submission>"):
-    """Every forbidden import in ``source``, as :class:`Violation` objects."""
+def scan_source(source, path="<submission>", extra=(), package="pcl_course"):
+    """Every forbidden import in ``source``, as :class:`Violation` objects.
+
+    ``extra``: dotted names forbidden on top of the packages, matched in
+    ``import a.b``, ``from a import b``, ``from . import b`` (relative to
+    ``package``) and attribute chains such as ``scipy.spatial`` after
+    ``import scipy``.
+    """
     try:
         tree = ast.parse(source, filename=str(path))
     except SyntaxError as exc:
         return [Violation(str(path), exc.lineno or 0, f"syntax error: {exc.msg}")]
     aliases = {}  # local name -> (module, attribute) for importlib & co.
+    modules = {}  # local name -> the dotted module it stands for (import x.y as z)
     found = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
             for alias in node.names:
-                if _forbidden(alias.name):
+                if _forbidden(alias.name, extra):
                     found.append(Violation(str(path), node.lineno, f"import {alias.name}"))
+                modules[alias.asname or alias.name.split(".")[0]] = (
+                    alias.name if alias.asname else alias.name.split(".")[0]
+                )
                 if alias.name == "importlib":
                     aliases[alias.asname or alias.name] = ("importlib",)
         elif isinstance(node, ast.ImportFrom):
-            if node.level == 0 and _forbidden(node.module):
-                found.append(Violation(str(path), node.lineno, f"from {node.module} import ..."))
+            base = node.module or ""
+            if node.level > 0:
+                base = ".".join(p for p in (package, base) if p)
+            if _forbidden(base, extra) and (node.level == 0 or extra):
+                found.append(
+                    Violation(str(path), node.lineno, f"from {'.' * node.level}{node.module or ''} import ...")
+                )
+            else:
+                for alias in node.names:
+                    if _forbidden(f"{base}.{alias.name}", extra):
+                        found.append(Violation(str(path), node.lineno, f"from {base} import {alias.name}"))
+            for alias in node.names:
+                modules[alias.asname or alias.name] = f"{base}.{alias.name}"
             if node.module == "importlib":
                 for alias in node.names:
                     aliases[alias.asname or alias.name] = ("importlib", alias.name)
+        elif isinstance(node, ast.Attribute) and extra:
+            dotted = _dotted(node)
+            head = dotted.split(".")[0] if dotted else None
+            if head in modules:
+                resolved = modules[head] + dotted[len(head) :]
+                if resolved in extra and not _forbidden(modules[head], extra):  # the chain's shortest match only
+                    found.append(Violation(str(path), node.lineno, resolved))
         elif isinstance(node, ast.Call):
             name = _call_name(node, aliases)
             if name in IMPORT_FUNCTIONS and node.args:
                 target = _literal_string(node.args[0])
                 if target is None:
                     found.append(Violation(str(path), node.lineno, f"{name[1]}() of a computed name"))
-                elif _forbidden(target):
+                elif _forbidden(target, extra):
                     found.append(Violation(str(path), node.lineno, f"{name[1]}({target!r})"))
-    return sorted(found, key=lambda v: v.line)
+    unique = {(v.line, v.what): v for v in found}
+    return sorted(unique.values(), key=lambda v: v.line)
 
 
-def scan_file(path):
-    return scan_source(Path(path).read_text(encoding="utf-8", errors="replace"), path)
+def scan_file(path, extra=()):
+    return scan_source(Path(path).read_text(encoding="utf-8", errors="replace"), path, extra)
 
 
 def module_files(directory):
@@ -166,9 +214,8 @@ def scan_package(directory, trusted_directory=None, overrides=None):
     """
     files = module_files(directory)
     files.update({name: [Path(path)] for name, path in (overrides or {}).items()})
-    own = {}
+    scanned = {name: [] for name in files}  # module -> its files to read (a pristine helper is not read)
     for name, paths in files.items():
-        own[name] = []
         for path in paths:
             trusted = Path(trusted_directory) / path.name if trusted_directory else None
             pristine = (
@@ -179,7 +226,12 @@ def scan_package(directory, trusted_directory=None, overrides=None):
                 and trusted.read_bytes() == path.read_bytes()
             )
             if not pristine:
-                own[name].extend(scan_file(path))
+                scanned[name].append(path)
+
+    def violations(module, extra):
+        return [v for path in scanned[module] for v in scan_file(path, extra)]
+
+    own = {name: violations(name, ()) for name in files}
     graph = {
         name: {n for path in paths for n in _imported_names(path, name)} & set(files) for name, paths in files.items()
     }
@@ -193,4 +245,13 @@ def scan_package(directory, trusted_directory=None, overrides=None):
                 stack.extend(graph.get(name, ()))
         return seen
 
-    return {name: [v for module in sorted(reachable(name)) if module in own for v in own[module]] for name in files}
+    result = {}
+    for name in files:
+        extra = FORBIDDEN_IN_MODULE.get(name, ())
+        reached = sorted(reachable(name))
+        # A module forbidden here (pcl_course.neighbors in nn) is a violation when imported at all,
+        # even unchanged; the imports are found in the importing module's own source.
+        result[name] = [
+            v for module in reached if module in own for v in (violations(module, extra) if extra else own[module])
+        ]
+    return result

@@ -32,7 +32,7 @@ import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grading import EXERCISE_MODULES, REPO_ROOT
+from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
 from grading.leakcheck import find_leaks
 from grading.results import Grading, clean
@@ -83,13 +83,17 @@ def _zip_entry(name):
     return info
 
 
-def build_archive(out_zip):
-    """Write the Gradescope autograder archive to ``out_zip``.
+def build_archive(out_zip, assignment):
+    """Write the Gradescope autograder archive of ``assignment`` to ``out_zip``.
 
     Parameters
     ----------
     out_zip : path
         The ``.zip`` to write (its folder is created).
+    assignment : str
+        A key of :data:`grading.config.ASSIGNMENTS`: the archive grades its
+        functions only, so each lecture is one Gradescope assignment with
+        its own total.
 
     Returns
     -------
@@ -101,8 +105,12 @@ def build_archive(out_zip):
     with tempfile.TemporaryDirectory(prefix="gradescope-") as work:
         root = Path(work)
         _course_copy(root / COURSE)
+        if assignment not in ASSIGNMENTS:
+            raise ValueError(f"assignment must be one of {sorted(ASSIGNMENTS)}, got {assignment!r}")
         for name in SCRIPTS:
-            shutil.copy2(TEMPLATES / name, root / name)
+            text = (TEMPLATES / name).read_text().replace("@ASSIGNMENT@", assignment)
+            (root / name).write_text(text)
+            os.chmod(root / name, (TEMPLATES / name).stat().st_mode & 0o777)
         leaks = find_leaks(root)
         if leaks:
             return leaks
@@ -199,8 +207,11 @@ def locate(submission):
     return located
 
 
-def assemble(submission, into):
+def assemble(submission, into, assignment=None):
     """Lay the submission's code over a pristine ``pcl_course/`` in ``into``.
+
+    ``assignment`` (a key of :data:`grading.config.ASSIGNMENTS`) names the
+    modules the note reports as found or missing; None: every exercise module.
 
     Every file of the submission is read as staging reads it (regular files
     only, no link followed, with caps): a link, a device or compiled code
@@ -219,6 +230,7 @@ def assemble(submission, into):
         When nothing gradable was found, or the submission cannot be staged.
     """
     submission = Path(submission)
+    graded = ASSIGNMENT_MODULES[assignment] if assignment else EXERCISE_MODULES
     located = locate(submission)
     package = Path(into) / "pcl_course"
     shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=IGNORED)
@@ -231,21 +243,23 @@ def assemble(submission, into):
             shutil.copyfile(staged.package / relative, target)
         shutil.rmtree(staged.root)
         where = located.package.relative_to(submission).as_posix() + "/"
-        found = [m for m in EXERCISE_MODULES if f"{m}.py" in staged.files or f"{m}/__init__.py" in staged.files]
+        found = [m for m in graded if f"{m}.py" in staged.files or f"{m}/__init__.py" in staged.files]
     elif located.modules:
         for name, path in located.modules.items():
             (package / f"{name}.py").write_bytes(read_regular_file(path, f"{path.relative_to(submission)}"))
         where = sorted({p.parent.relative_to(submission).as_posix() for p in located.modules.values()})
         where = "the uploaded files" if where == ["."] else ", ".join(f"{w}/" for w in where)
-        found = list(located.modules)
+        found = [m for m in located.modules if m in graded]
     else:
         expected = ", ".join(f"{m}.py" for m in EXERCISE_MODULES)
         raise StagingError(
             f"no pcl_course/ folder and none of {expected} in the submission: "
             "upload your repository, its pcl_course/ folder, or those files"
         )
-    missing = [m for m in EXERCISE_MODULES if m not in found]
-    note = f"Graded from {where}: " + ", ".join(f"`{m}.py`" for m in found) + "."
+    missing = [m for m in graded if m not in found]
+    note = (
+        f"Graded from {where}: " + (", ".join(f"`{m}.py`" for m in found) or "none of this assignment's modules") + "."
+    )
     if missing:
         note += " Missing (graded as the course's stub, 0 points): " + ", ".join(f"`{m}.py`" for m in missing) + "."
     if located.ignored:
@@ -269,8 +283,11 @@ def _write_json(path, content):
     os.replace(temporary, path)
 
 
-def autograde(root="/autograder", budget=None):
+def autograde(root="/autograder", budget=None, assignment="lecture1"):
     """Grade ``root/submission`` into ``root/results/results.json``; return the exit status.
+
+    Only the functions of ``assignment`` are graded: its archive is one
+    Gradescope assignment (:func:`build_archive`).
 
     A submission that cannot be graded (nothing found, refused by staging,
     or a container where it cannot be isolated) still gets a results file,
@@ -295,7 +312,7 @@ def autograde(root="/autograder", budget=None):
     work = Path(tempfile.mkdtemp(prefix="gradescope-submission-"))
     try:
         try:
-            package, note = assemble(root / "submission", work)
+            package, note = assemble(root / "submission", work, assignment)
         except StagingError as exc:
             message = f"submission refused: {exc}"
             _write_json(results, _failure_results(message, started))
@@ -304,7 +321,13 @@ def autograde(root="/autograder", budget=None):
         print(note)
         remaining = None if budget is None else max(0.0, budget - (time.monotonic() - started))
         code, output = run_graded_tests(
-            package, results, sandbox=True, require_isolation=True, note=note, budget=remaining
+            package,
+            results,
+            sandbox=True,
+            require_isolation=True,
+            note=note,
+            budget=remaining,
+            functions=list(ASSIGNMENTS[assignment]),
         )
         print(output)
         if code not in (0, 1) or not results.exists():

@@ -19,6 +19,10 @@ __all__ = [
     "check_integer",
     "check_choice",
     "check_rng",
+    "check_radius",
+    "check_bst",
+    "check_kdtree",
+    "check_octree",
 ]
 
 
@@ -220,3 +224,144 @@ def check_rng(rng, name="rng"):
     if isinstance(rng, numbers.Integral) and not isinstance(rng, bool) and rng >= 0:
         return np.random.default_rng(int(rng))
     raise ValueError(f"{name} must be None, a non-negative int seed or a numpy Generator, got {rng!r}")
+
+
+def check_radius(value, name="radius"):
+    """Return ``value`` as a float after checking it is finite and ``>= 0``.
+
+    A radius of 0 is allowed in neighbour search: it finds the exact
+    duplicates of a query (distance 0).
+    """
+    if not _is_real_number(value) or not np.isfinite(value) or value < 0:
+        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return float(value)
+
+
+KDTREE_KEYS = {"order": "i", "start": "i", "stop": "i", "axis": "i", "split": "f", "left": "i", "right": "i"}
+OCTREE_KEYS = {"order": "i", "start": "i", "stop": "i", "center": "f", "extent": "f", "children": "i"}
+
+
+def _tree_arrays(tree, name, keys, n_points):
+    """The arrays of a tree dict with exactly ``keys`` (int64 or float64), and its node count M."""
+    if not isinstance(tree, dict) or set(tree) != set(keys):
+        got = sorted(tree) if isinstance(tree, dict) else type(tree).__name__
+        raise ValueError(f"{name} must be a dict with exactly the keys {sorted(keys)}, got {got}")
+    arrays = {}
+    for key, kind in keys.items():
+        array = tree[key]
+        dtype = np.int64 if kind == "i" else np.float64
+        if not isinstance(array, np.ndarray) or array.dtype != dtype:
+            raise ValueError(f"{name}[{key!r}] must be a NumPy array of {np.dtype(dtype).name}")
+        arrays[key] = array
+    order = arrays["order"]
+    if order.shape != (n_points,) or not np.array_equal(np.sort(order), np.arange(n_points)):
+        raise ValueError(
+            f"{name}['order'] must be a permutation of the {n_points} point indices (a tree of these points)"
+        )
+    n_nodes = len(arrays["start"])
+    if n_nodes < 1 or arrays["start"].shape != (n_nodes,) or arrays["stop"].shape != (n_nodes,):
+        raise ValueError(f"{name}['start'] and {name}['stop'] must have one entry per node, and there is a root")
+    start, stop = arrays["start"], arrays["stop"]
+    if np.any(start < 0) or np.any(stop < start) or np.any(stop > n_points) or start[0] != 0 or stop[0] != n_points:
+        raise ValueError(f"{name}: node ranges must satisfy 0 <= start <= stop <= N, and the root holds every point")
+    return arrays, n_nodes
+
+
+def _check_children(children, parents, n_nodes, name, key):
+    """One tree rooted at node 0: every other node is the child of exactly one node with a smaller id."""
+    valid = (children == -1) | ((children > parents) & (children < n_nodes))
+    if not np.all(valid):
+        raise ValueError(f"{name}[{key!r}] must hold node ids greater than their parent's and below M, or -1")
+    ids = children[children >= 0]
+    if len(np.unique(ids)) != len(ids) or len(ids) != n_nodes - 1:
+        raise ValueError(f"{name}: every node but the root must be the child of exactly one node")
+
+
+def check_bst(left, right, n_keys):
+    """``left`` and ``right`` as int64 arrays after checking they form one binary tree on ``n_keys`` nodes.
+
+    As :func:`pcl_course.nn.bst_build` returns them: node 0 is the root and
+    every other node is the child of exactly one node inserted before it
+    (a smaller id). Only the links are checked, never the order of the keys.
+
+    Raises
+    ------
+    ValueError
+        Naming ``left``/``right``.
+    """
+    arrays = []
+    for name, links in (("left", left), ("right", right)):
+        array = as_array(links, name, ndim=1, dtype=np.float64)
+        if array.shape != (n_keys,) or not np.array_equal(array, np.round(array)):
+            raise ValueError(f"{name} must hold {n_keys} integer node ids (one per key), got shape {array.shape}")
+        arrays.append(array.astype(np.int64))
+    if n_keys:
+        nodes = np.arange(n_keys)
+        _check_children(np.concatenate(arrays), np.concatenate([nodes, nodes]), n_keys, "left/right", "links")
+    return arrays[0], arrays[1]
+
+
+def check_kdtree(tree, n_points, dim, name="tree"):
+    """Check the structure of a k-d tree dict built on ``n_points`` points of ``dim`` columns.
+
+    Parameters
+    ----------
+    tree : dict
+        As :func:`pcl_course.nn.kdtree_build` returns: exactly the keys
+        ``order, start, stop, axis, split, left, right``.
+    n_points, dim : int
+        N and D of the cloud the search is given.
+    name : str, default "tree"
+        The argument's name, for the message.
+
+    Returns
+    -------
+    dict
+        The same arrays (not copied).
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``: a missing or extra key, a wrong dtype or shape, a
+        tree of another N, or links that do not form one tree rooted at node 0.
+
+    Notes
+    -----
+    Only the structure is checked, never the geometry: whether the points
+    lie on the sides of the splits that the tree says. A search must trust
+    the tree (reading points of a node only when its rule reaches it); the
+    grader's structure tests hand it trees whose unreached nodes lie.
+    """
+    arrays, n_nodes = _tree_arrays(tree, name, KDTREE_KEYS, n_points)
+    for key in ("axis", "split", "left", "right"):
+        if arrays[key].shape != (n_nodes,):
+            raise ValueError(f"{name}[{key!r}] must have shape ({n_nodes},), one entry per node")
+    left, right, axis = arrays["left"], arrays["right"], arrays["axis"]
+    leaf = left < 0
+    if np.any(leaf != (right < 0)) or np.any(leaf != (axis < 0)) or np.any(axis >= max(dim, 1)):
+        raise ValueError(f"{name}: a node must have two children and an axis in 0..D-1, or be a leaf (-1, -1, -1)")
+    if not np.all(np.isnan(arrays["split"][leaf])) or not np.all(np.isfinite(arrays["split"][~leaf])):
+        raise ValueError(f"{name}['split'] must be finite at internal nodes and NaN at leaves")
+    nodes = np.arange(n_nodes)
+    _check_children(np.concatenate([left, right]), np.concatenate([nodes, nodes]), n_nodes, name, "left/right")
+    return arrays
+
+
+def check_octree(tree, n_points, name="tree"):
+    """Check the structure of an octree dict built on ``n_points`` points.
+
+    As :func:`check_kdtree`, for the keys ``order, start, stop, center,
+    extent, children`` of :func:`pcl_course.nn.octree_build`: ``center``
+    (M, 3) finite, ``extent`` (M,) finite and >= 0, ``children`` (M, 8).
+    Only the structure is checked, never the geometry.
+    """
+    arrays, n_nodes = _tree_arrays(tree, name, OCTREE_KEYS, n_points)
+    shapes = {"center": (n_nodes, 3), "extent": (n_nodes,), "children": (n_nodes, 8)}
+    for key, shape in shapes.items():
+        if arrays[key].shape != shape:
+            raise ValueError(f"{name}[{key!r}] must have shape {shape}, one row per node")
+    if not np.all(np.isfinite(arrays["center"])) or not np.all(np.isfinite(arrays["extent"]) & (arrays["extent"] >= 0)):
+        raise ValueError(f"{name}['center'] must be finite and {name}['extent'] finite and >= 0")
+    parents = np.repeat(np.arange(n_nodes), 8)
+    _check_children(arrays["children"].ravel(), parents, n_nodes, name, "children")
+    return arrays

@@ -45,7 +45,18 @@ def run_batch(classroom, csv_path, *args):
     import csv
 
     completed = subprocess.run(
-        [sys.executable, "-m", "grading", "batch", str(classroom), "--csv", str(csv_path), *args],
+        [
+            sys.executable,
+            "-m",
+            "grading",
+            "batch",
+            str(classroom),
+            "--assignment",
+            "lecture1",
+            "--csv",
+            str(csv_path),
+            *args,
+        ],
         cwd=REPO_ROOT,
         capture_output=True,
         text=True,

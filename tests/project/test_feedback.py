@@ -161,6 +161,6 @@ def test_batch_in_the_uid_mode_refuses_a_class_folder_the_sandbox_can_read(tmp_p
     sandbox._make_reachable(classroom)  # as a class folder under /home or /srv is
     monkeypatch.setattr(sandbox, "isolation", lambda uid=None: sandbox.Isolation(sandbox.UID, 60530, "test"))
     with pytest.raises(SystemExit) as refused:
-        cli.main(["batch", str(classroom), "--out", str(tmp_path / "out")])
+        cli.main(["batch", str(classroom), "--assignment", "lecture1", "--out", str(tmp_path / "out")])
     assert "refusing to grade the class" in str(refused.value) and f"chmod 700 {classroom}" in str(refused.value)
     assert os.stat(tmp_path / "out").st_mode & 0o777 == 0o700  # the results folder: the grader's only

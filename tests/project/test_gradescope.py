@@ -25,7 +25,7 @@ from pathlib import Path
 import pytest
 from _helpers import load_results, reference_package, reference_source
 
-from grading import EXERCISE_MODULES, GRADED_FUNCTIONS, REPO_ROOT
+from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, REPO_ROOT
 from grading.leakcheck import find_leaks
 from grading.sandbox import _make_reachable
 
@@ -36,7 +36,10 @@ needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="the dedicated-uid wal
 def archive(tmp_path_factory):
     out = tmp_path_factory.mktemp("archive") / "autograder.zip"
     completed = subprocess.run(
-        [sys.executable, "-m", "grading", "gradescope", str(out)], cwd=REPO_ROOT, capture_output=True, text=True
+        [sys.executable, "-m", "grading", "gradescope", str(out), "--assignment", "lecture1"],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
     )
     assert completed.returncode == 0, completed.stderr
     return out
@@ -97,12 +100,15 @@ def test_the_reference_uploaded_as_a_repository_gets_full_marks(archive, tmp_pat
     reference_package(root / "submission" / "my-repo" / "pcl_course")
     results, printed = run_autograder(root)
     assert results["score"] == sum(t["max_score"] for t in results["tests"]) > 0
-    assert {t["tags"][0] for t in results["tests"]} == set(GRADED_FUNCTIONS)
+    assert {t["tags"][0] for t in results["tests"]} == set(ASSIGNMENTS["lecture1"])
     hidden = [t for t in results["tests"] if t["visibility"] == "after_published"]
     assert hidden and all("hidden" in t["name"] for t in hidden)
     assert all(t["visibility"] == "visible" for t in results["tests"] if t not in hidden)
     first, isolation = results["grading"].note, results["grading"].isolation
-    assert first == "Graded from my-repo/pcl_course/: " + ", ".join(f"`{m}.py`" for m in EXERCISE_MODULES) + "."
+    assert (
+        first
+        == "Graded from my-repo/pcl_course/: " + ", ".join(f"`{m}.py`" for m in ASSIGNMENT_MODULES["lecture1"]) + "."
+    )
     assert isolation.startswith("isolated: bubblewrap")
     assert "Traceback" not in printed
 
@@ -132,7 +138,7 @@ def test_a_wrong_module_uploaded_alone_is_graded_without_namespaces(archive, tmp
     lines = [results["grading"].note, results["grading"].isolation]
     assert lines[0] == (
         "Graded from the uploaded files: `pca.py`. Missing (graded as the course's stub, 0 points): "
-        + ", ".join(f"`{m}.py`" for m in EXERCISE_MODULES if m != "pca")
+        + ", ".join(f"`{m}.py`" for m in ASSIGNMENT_MODULES["lecture1"] if m != "pca")
         + ". Not graded (not exercise modules): `helpers.py`."
     )
     assert lines[1].startswith("isolated: dedicated uid") and "seccomp" in lines[1]

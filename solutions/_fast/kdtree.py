@@ -1,0 +1,239 @@
+"""The course's k-d tree (median rule, preorder nodes) and its searches (numba, every core).
+
+The layout is the contract's (``pcl_course/nn.py``): one ``order`` array and
+per-node ``start/stop/axis/split/left/right``. The build selects each median
+in linear time (a quickselect on (coordinate, index) pairs, which are all
+distinct), so it costs O(N log N) and not the O(N log^2 N) of a sort per
+node. The searches keep the k best as a sorted array, which for the k of
+point-cloud work (8 to 32) beats a heap: most offers are rejected by one
+comparison with the last entry.
+"""
+
+import numpy as np
+from numba import njit
+
+__all__ = ["build", "knn", "radius_count", "radius_fill", "offer"]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _less(points, axis, a, b):
+    """(coordinate, index) of point a before that of point b."""
+    ca, cb = points[a, axis], points[b, axis]
+    return ca < cb or (ca == cb and a < b)
+
+
+@njit(cache=True, nogil=True)
+def _select(order, lo, hi, nth, points, axis):
+    """Reorder ``order[lo:hi]`` so that its first ``nth - lo`` entries are the smallest by (coordinate, index)."""
+    while hi - lo > 2:
+        mid = (lo + hi) // 2
+        # Median of three as pivot, moved to hi - 1.
+        a, b, c = order[lo], order[mid], order[hi - 1]
+        if _less(points, axis, b, a):
+            a, b = b, a
+        if _less(points, axis, c, b):
+            b, c = c, b
+            if _less(points, axis, b, a):
+                a, b = b, a
+        order[lo], order[mid], order[hi - 1] = a, c, b
+        pivot = b
+        store = lo
+        for i in range(lo, hi - 1):
+            if _less(points, axis, order[i], pivot):
+                order[i], order[store] = order[store], order[i]
+                store += 1
+        order[store], order[hi - 1] = order[hi - 1], order[store]
+        if store == nth:
+            return
+        if store < nth:
+            lo = store + 1
+        else:
+            hi = store
+    if hi - lo == 2 and _less(points, axis, order[lo + 1], order[lo]):
+        order[lo], order[lo + 1] = order[lo + 1], order[lo]
+
+
+@njit(cache=True, nogil=True)
+def build(points, leaf_size):
+    """The contract's k-d tree of ``points`` (N, D): (order, start, stop, axis, split, left, right)."""
+    n, dim = points.shape
+    capacity = 2 * max(n, 1) + 1
+    start = np.empty(capacity, dtype=np.int64)
+    stop = np.empty(capacity, dtype=np.int64)
+    axis = np.full(capacity, -1, dtype=np.int64)
+    split = np.full(capacity, np.nan)
+    left = np.full(capacity, -1, dtype=np.int64)
+    right = np.full(capacity, -1, dtype=np.int64)
+    order = np.arange(n)
+    # Pending nodes: (lo, hi, depth, parent); a parent >= 0 is waiting for its right child's id.
+    pending = np.empty((capacity, 4), dtype=np.int64)
+    pending[0] = (0, n, 0, -1)
+    top = 1
+    count = 0
+    while top > 0:
+        top -= 1
+        lo, hi, depth, parent = pending[top]
+        node = count
+        count += 1
+        if parent >= 0:
+            right[parent] = node
+        start[node], stop[node] = lo, hi
+        size = hi - lo
+        if size <= leaf_size:
+            order[lo:hi] = np.sort(order[lo:hi])
+            continue
+        a = depth % dim
+        m = lo + (size + 1) // 2
+        _select(order, lo, hi, m, points, a)
+        below = points[order[lo], a]
+        for i in range(lo + 1, m):
+            below = max(below, points[order[i], a])
+        above = points[order[m], a]
+        for i in range(m + 1, hi):
+            above = min(above, points[order[i], a])
+        axis[node] = a
+        split[node] = (below + above) / 2
+        left[node] = count  # preorder: the left child comes next
+        pending[top] = (m, hi, depth + 1, node)
+        pending[top + 1] = (lo, m, depth + 1, -1)
+        top += 2
+    return order, start[:count], stop[:count], axis[:count], split[:count], left[:count], right[:count]
+
+
+@njit(cache=True, nogil=True, inline="always")
+def offer(s, index, held_s, held_i, count, k):
+    """Offer (s, index) to the sorted result set ``held_*[:count]`` of capacity k; the new count."""
+    if count == k:
+        last_s, last_i = held_s[k - 1], held_i[k - 1]
+        if s > last_s or (s == last_s and index > last_i):
+            return count
+        position = k - 1
+    else:
+        position = count
+        count += 1
+    while position > 0 and (held_s[position - 1] > s or (held_s[position - 1] == s and held_i[position - 1] > index)):
+        held_s[position] = held_s[position - 1]
+        held_i[position] = held_i[position - 1]
+        position -= 1
+    held_s[position] = s
+    held_i[position] = index
+    return count
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _squared_distance(points, index, query):
+    s = 0.0
+    for j in range(query.shape[0]):
+        d = points[index, j] - query[j]
+        s += d * d
+    return s
+
+
+@njit(cache=True, nogil=True)
+def knn(order, start, stop, axis, split, left, right, points, queries, k, first, last, indices, distances):
+    """k nearest neighbours of ``queries[first:last]`` into ``indices``/``distances`` (the contract's rule)."""
+    stack_node = np.empty(128, dtype=np.int64)
+    stack_d2 = np.empty(128)
+    held_s = np.empty(k)
+    held_i = np.empty(k, dtype=np.int64)
+    for qi in range(first, last):
+        query = queries[qi]
+        count = 0
+        worst = np.inf
+        stack_node[0], stack_d2[0] = 0, 0.0
+        top = 1
+        while top > 0:
+            top -= 1
+            node, plane = stack_node[top], stack_d2[top]
+            if plane > worst:
+                continue
+            a = axis[node]
+            if a < 0:
+                for position in range(start[node], stop[node]):
+                    index = order[position]
+                    count = offer(_squared_distance(points, index, query), index, held_s, held_i, count, k)
+                if count == k:
+                    worst = held_s[k - 1]
+                continue
+            diff = query[a] - split[node]
+            near, far = (left[node], right[node]) if diff <= 0 else (right[node], left[node])
+            if top + 2 > stack_node.shape[0]:
+                stack_node = np.concatenate((stack_node, np.empty_like(stack_node)))
+                stack_d2 = np.concatenate((stack_d2, np.empty_like(stack_d2)))
+            stack_node[top], stack_d2[top] = far, diff * diff
+            stack_node[top + 1], stack_d2[top + 1] = near, 0.0
+            top += 2
+        for j in range(k):
+            indices[qi, j] = held_i[j]
+            distances[qi, j] = np.sqrt(held_s[j])
+
+
+@njit(cache=True, nogil=True)
+def _radius_walk(order, start, stop, axis, split, left, right, points, query, r2, out_s, out_i):
+    """Points within sqrt(r2) of ``query`` into out_s/out_i (grown as needed); returns (count, out_s, out_i)."""
+    stack = np.empty(128, dtype=np.int64)
+    stack[0] = 0
+    top = 1
+    count = 0
+    while top > 0:
+        top -= 1
+        node = stack[top]
+        a = axis[node]
+        if a < 0:
+            for position in range(start[node], stop[node]):
+                index = order[position]
+                s = _squared_distance(points, index, query)
+                if s <= r2:
+                    if count == out_s.shape[0]:
+                        out_s = np.concatenate((out_s, np.empty_like(out_s)))
+                        out_i = np.concatenate((out_i, np.empty_like(out_i)))
+                    out_s[count], out_i[count] = s, index
+                    count += 1
+            continue
+        diff = query[a] - split[node]
+        near, far = (left[node], right[node]) if diff <= 0 else (right[node], left[node])
+        if top + 2 > stack.shape[0]:
+            stack = np.concatenate((stack, np.empty_like(stack)))
+        if diff * diff <= r2:
+            stack[top] = far
+            top += 1
+        stack[top] = near
+        top += 1
+    return count, out_s, out_i
+
+
+@njit(cache=True, nogil=True)
+def sort_pairs(s, index):
+    """Order of the pairs (s, index) ascending, ties by index."""
+    by_index = np.argsort(index)
+    return by_index[np.argsort(s[by_index], kind="mergesort")]
+
+
+@njit(cache=True, nogil=True)
+def radius_count(order, start, stop, axis, split, left, right, points, queries, r2, first, last, counts):
+    """``counts[qi]``: neighbours of each query of ``queries[first:last]`` within sqrt(r2)."""
+    out_s = np.empty(64)
+    out_i = np.empty(64, dtype=np.int64)
+    for qi in range(first, last):
+        c, out_s, out_i = _radius_walk(
+            order, start, stop, axis, split, left, right, points, queries[qi], r2, out_s, out_i
+        )
+        counts[qi] = c
+
+
+@njit(cache=True, nogil=True)
+def radius_fill(
+    order, start, stop, axis, split, left, right, points, queries, r2, indptr, first, last, indices, distances
+):
+    """Fill the CSR rows of ``queries[first:last]`` (``indptr`` from :func:`radius_count`), each sorted."""
+    out_s = np.empty(64)
+    out_i = np.empty(64, dtype=np.int64)
+    for qi in range(first, last):
+        c, out_s, out_i = _radius_walk(
+            order, start, stop, axis, split, left, right, points, queries[qi], r2, out_s, out_i
+        )
+        rank = sort_pairs(out_s[:c], out_i[:c])
+        base = indptr[qi]
+        for j in range(c):
+            indices[base + j] = out_i[rank[j]]
+            distances[base + j] = np.sqrt(out_s[rank[j]])

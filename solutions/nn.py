@@ -1,0 +1,233 @@
+"""Reference: nearest-neighbour search with a BST, a k-d tree and an octree.
+
+The trees and their searches are compiled (``solutions/_fast/kdtree.py`` and
+``octree.py``); queries run on every core. The docstrings are the stubs'
+(``pcl_course/nn.py``), which state the contract.
+"""
+
+import numpy as np
+from numba import njit
+
+from pcl_course import nn as _contract
+from pcl_course.validation import (
+    as_array,
+    as_points,
+    check_bst,
+    check_integer,
+    check_kdtree,
+    check_octree,
+    check_radius,
+    check_scalar,
+)
+from solutions._fast import kdtree as _kdtree
+from solutions._fast import octree as _octree
+from solutions._fast.threads import in_threads
+
+__all__ = [
+    "knn_result_set",
+    "bst_build",
+    "bst_knn",
+    "kdtree_build",
+    "kdtree_knn",
+    "kdtree_radius",
+    "octree_build",
+    "octree_radius",
+    "octree_knn",
+]
+
+
+def _documented(function):
+    function.__doc__ = getattr(_contract, function.__name__).__doc__
+    return function
+
+
+# -- result set and binary search tree --------------------------------------------------------
+
+
+@njit(cache=True)
+def _result_set(distances, indices, k):
+    n = distances.shape[0]
+    held_s = np.empty(min(k, n))
+    held_i = np.empty(min(k, n), dtype=np.int64)
+    worst = np.full(n, np.inf)
+    count = 0
+    for j in range(n):
+        count = _kdtree.offer(distances[j], indices[j], held_s, held_i, count, min(k, n))
+        if count == k:
+            worst[j] = held_s[k - 1]
+    return held_i[:count], held_s[:count], worst
+
+
+@_documented
+def knn_result_set(distances, indices, k):
+    distances = as_array(distances, "distances", ndim=1)
+    if np.any(distances < 0):
+        raise ValueError("distances must be >= 0")
+    values = as_array(indices, "indices", ndim=1)
+    if values.shape != distances.shape or not np.array_equal(values, np.round(values)):
+        raise ValueError(f"indices must be {len(distances)} integers, one per distance, got shape {values.shape}")
+    values = values.astype(np.int64)
+    if len(np.unique(values)) != len(values):
+        raise ValueError("indices must be distinct")
+    k = check_integer(k, "k", low=1)
+    return _result_set(distances, values, k)
+
+
+@njit(cache=True)
+def _bst_insert_all(keys):
+    n = keys.shape[0]
+    left = np.full(n, -1, dtype=np.int64)
+    right = np.full(n, -1, dtype=np.int64)
+    for i in range(1, n):
+        node = 0
+        while True:
+            if keys[i] < keys[node]:
+                if left[node] < 0:
+                    left[node] = i
+                    break
+                node = left[node]
+            else:
+                if right[node] < 0:
+                    right[node] = i
+                    break
+                node = right[node]
+    return left, right
+
+
+@_documented
+def bst_build(keys):
+    keys = as_array(keys, "keys", ndim=1)
+    return _bst_insert_all(keys)
+
+
+@njit(cache=True)
+def _bst_search(keys, left, right, query, k):
+    held_s = np.empty(k)
+    held_i = np.empty(k, dtype=np.int64)
+    count = 0
+    worst = np.inf
+    # Frames: (node, state); state 0 = not entered, 1 = near side done.
+    stack_node = np.empty(keys.shape[0] + 1, dtype=np.int64)
+    stack_state = np.empty(keys.shape[0] + 1, dtype=np.int64)
+    stack_node[0], stack_state[0] = 0, 0
+    top = 1
+    while top > 0:
+        node, state = stack_node[top - 1], stack_state[top - 1]
+        gap = abs(keys[node] - query)
+        go_left = query < keys[node]
+        if state == 0:
+            count = _kdtree.offer(gap, node, held_s, held_i, count, k)
+            if count == k:
+                worst = held_s[k - 1]
+            stack_state[top - 1] = 1
+            near = left[node] if go_left else right[node]
+            if near >= 0:
+                stack_node[top], stack_state[top] = near, 0
+                top += 1
+            continue
+        top -= 1
+        far = right[node] if go_left else left[node]
+        if far >= 0 and gap <= worst:
+            stack_node[top], stack_state[top] = far, 0
+            top += 1
+    return held_i, held_s
+
+
+@_documented
+def bst_knn(keys, left, right, query, k):
+    keys = as_array(keys, "keys", ndim=1)
+    left, right = check_bst(left, right, len(keys))
+    query = check_scalar(query, "query")
+    k = check_integer(k, "k", low=1, high=len(keys))
+    return _bst_search(keys, left, right, query, k)
+
+
+# -- k-d tree ----------------------------------------------------------------------------------
+
+_KDTREE_KEYS = ("order", "start", "stop", "axis", "split", "left", "right")
+
+
+def _cloud_and_queries(points, queries, min_columns):
+    points = as_points(points, min_columns=min_columns)
+    queries = as_points(queries, "queries", columns=points.shape[1])
+    return np.ascontiguousarray(points), np.ascontiguousarray(queries)
+
+
+@_documented
+def kdtree_build(points, leaf_size=16):
+    points = np.ascontiguousarray(as_points(points, min_columns=1))
+    leaf_size = check_integer(leaf_size, "leaf_size", low=1)
+    return dict(zip(_KDTREE_KEYS, _kdtree.build(points, leaf_size)))
+
+
+def _kdtree_arrays(tree, points):
+    arrays = check_kdtree(tree, len(points), points.shape[1])
+    return tuple(arrays[key] for key in _KDTREE_KEYS)
+
+
+@_documented
+def kdtree_knn(tree, points, queries, k):
+    points, queries = _cloud_and_queries(points, queries, 1)
+    arrays = _kdtree_arrays(tree, points)
+    k = check_integer(k, "k", low=1, high=len(points))
+    indices = np.empty((len(queries), k), dtype=np.int64)
+    distances = np.empty((len(queries), k))
+    in_threads(_kdtree.knn, len(queries), (*arrays, points, queries, k), (indices, distances), grain=1024)
+    return indices, distances
+
+
+def _csr(count_kernel, fill_kernel, inputs, n_queries):
+    """Run a radius search in two passes (counts, then sorted rows) into CSR arrays."""
+    counts = np.zeros(n_queries, dtype=np.int64)
+    in_threads(count_kernel, n_queries, inputs, (counts,), grain=1024)
+    indptr = np.zeros(n_queries + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    indices = np.empty(indptr[-1], dtype=np.int64)
+    distances = np.empty(indptr[-1])
+    in_threads(fill_kernel, n_queries, (*inputs, indptr), (indices, distances), grain=1024)
+    return indptr, indices, distances
+
+
+@_documented
+def kdtree_radius(tree, points, queries, radius):
+    points, queries = _cloud_and_queries(points, queries, 1)
+    arrays = _kdtree_arrays(tree, points)
+    radius = check_radius(radius)
+    return _csr(_kdtree.radius_count, _kdtree.radius_fill, (*arrays, points, queries, radius**2), len(queries))
+
+
+# -- octree ------------------------------------------------------------------------------------
+
+_OCTREE_KEYS = ("order", "start", "stop", "center", "extent", "children")
+
+
+@_documented
+def octree_build(points, leaf_size=8, min_extent=1e-3):
+    xyz = np.ascontiguousarray(as_points(points)[:, :3])
+    leaf_size = check_integer(leaf_size, "leaf_size", low=1)
+    min_extent = check_scalar(min_extent, "min_extent", low=0, include_low=False)
+    return dict(zip(_OCTREE_KEYS, _octree.build(xyz, leaf_size, min_extent)))
+
+
+def _octree_inputs(tree, points, queries):
+    points, queries = _cloud_and_queries(points, queries, 3)
+    arrays = check_octree(tree, len(points))
+    xyz = np.ascontiguousarray(points[:, :3])
+    return tuple(arrays[key] for key in _OCTREE_KEYS), xyz, np.ascontiguousarray(queries[:, :3])
+
+
+@_documented
+def octree_radius(tree, points, queries, radius):
+    arrays, xyz, queries = _octree_inputs(tree, points, queries)
+    radius = check_radius(radius)
+    return _csr(_octree.radius_count, _octree.radius_fill, (*arrays, xyz, queries, radius**2), len(queries))
+
+
+@_documented
+def octree_knn(tree, points, queries, k):
+    arrays, xyz, queries = _octree_inputs(tree, points, queries)
+    k = check_integer(k, "k", low=1, high=len(xyz))
+    indices = np.empty((len(queries), k), dtype=np.int64)
+    distances = np.empty((len(queries), k))
+    in_threads(_octree.knn, len(queries), (*arrays, xyz, queries, k), (indices, distances), grain=1024)
+    return indices, distances
