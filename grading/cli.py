@@ -324,7 +324,7 @@ def batch(args):
                 ]
             )
     if args.gradebook:
-        write_gradebook(args.gradebook, args.assignment, folders, args.roster)
+        write_gradebook(args.gradebook, args.gradebook_column or args.assignment, folders, args.roster)
     for folder, output in graded:
         mark = f"{folder.grading.score:g} / {folder.grading.max_score:g}" if folder.grading else folder.status
         print(f"{folder.name}: {mark}" + ("" if folder.grading else f" ({folder.note})" if folder.note else ""))
@@ -426,7 +426,8 @@ def main(argv=None):
     b.add_argument("-k", help="select tests as pytest -k does")
     b.add_argument("--gradebook", metavar="CSV", help="also write the totals in Canvas's gradebook layout here")
     b.add_argument(
-        "--assignment", default="Lecture 1 exercises", help="the gradebook column of the totals (Canvas assignment)"
+        "--gradebook-column",
+        help="the gradebook column of the totals (Canvas assignment; default: the assignment's name)",
     )
     b.add_argument(
         "--roster",

@@ -51,7 +51,7 @@ def batch_with_gradebook(classroom, tmp_path, roster_text, assignment):
         "test_chamfer_distance_",
         "--gradebook",
         str(gradebook),
-        "--assignment",
+        "--gradebook-column",
         assignment,
         "--roster",
         str(roster),

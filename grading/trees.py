@@ -1,0 +1,382 @@
+"""The grader's own trees for lecture 2: canonical builds, the contract's searches with the
+nodes they reach, and the lying trees of the structure tests.
+
+Written from the contract in ``pcl_course/nn.py``, independently of
+``solutions/`` (plain Python and NumPy, slow and simple). The searches are
+graded on trees built here, so a wrong build costs its points once; the
+expected answers of every test come from brute force on the points, never
+from this module.
+
+**Decoy trees** (the book's chapter on k-d trees proves why they are fair):
+run the contract's search on one query and record the nodes it reaches;
+then move one point of every node it does not reach next to the query. The
+tree still says those points are where they were. A search that follows the
+rule, or prunes more, never reads them and returns the true answer; one that
+reads an unreached node (brute force, a library, no pruning, the far side
+first, a too-weak test) returns a decoy.
+
+This module answers exercises, so it ships with the instructors' grader only
+(``grading.shipping.INSTRUCTOR_ONLY_GRADER``), never in the student release.
+"""
+
+import math
+
+import numpy as np
+
+__all__ = [
+    "bst",
+    "kdtree",
+    "octree",
+    "bst_reach",
+    "kdtree_reach",
+    "octree_reach",
+    "decoy_points",
+    "brute_knn",
+    "brute_radius",
+]
+
+# Decoys sit this far from the query, as a fraction of the true nearest distance,
+# each at its own distance so that their order is defined.
+DECOY_FRACTION = 1e-3
+
+
+# -- brute force (the expected answers) ----------------------------------------------------------
+
+
+def squared_distances(points, query):
+    """``sum_j (p_j - q_j) ** 2`` in increasing j, as the contract defines it."""
+    total = np.zeros(len(points))
+    for j in range(points.shape[1]):
+        total += (points[:, j] - query[j]) ** 2
+    return total
+
+
+def brute_knn(points, query, k):
+    """Indices and distances of the k nearest by (squared distance, index)."""
+    s = squared_distances(points, query)
+    rank = np.lexsort((np.arange(len(points)), s))[:k]
+    return rank.astype(np.int64), np.sqrt(s[rank])
+
+
+def brute_radius(points, query, radius):
+    """Indices and distances within ``radius`` (inclusive), ascending by (squared distance, index)."""
+    s = squared_distances(points, query)
+    inside = np.flatnonzero(s <= radius**2)
+    rank = inside[np.lexsort((inside, s[inside]))]
+    return rank.astype(np.int64), np.sqrt(s[rank])
+
+
+# -- builds --------------------------------------------------------------------------------------
+
+
+def bst(keys):
+    """``(left, right)`` of the BST of ``keys`` inserted in order (equal keys go right)."""
+    n = len(keys)
+    left, right = np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
+    for i in range(1, n):
+        node = 0
+        while True:
+            links = left if keys[i] < keys[node] else right
+            if links[node] < 0:
+                links[node] = i
+                break
+            node = links[node]
+    return left, right
+
+
+def kdtree(points, leaf_size):
+    """The contract's k-d tree (median rule, round-robin axes, preorder) as its dict."""
+    points = np.asarray(points, dtype=float)
+    n, dim = points.shape
+    nodes = []  # [start, stop, axis, split, left, right]
+    order = []
+
+    def grow(indices, depth):
+        node = len(nodes)
+        nodes.append([len(order), None, -1, math.nan, -1, -1])
+        if len(indices) <= leaf_size:
+            order.extend(sorted(indices))
+        else:
+            axis = depth % dim
+            ranked = sorted(indices, key=lambda i: (points[i, axis], i))
+            m = (len(ranked) + 1) // 2
+            nodes[node][2] = axis
+            nodes[node][3] = (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2
+            nodes[node][4] = grow(ranked[:m], depth + 1)
+            nodes[node][5] = grow(ranked[m:], depth + 1)
+        nodes[node][1] = len(order)
+        return node
+
+    grow(list(range(n)), 0)
+    table = list(zip(*nodes))
+    return {
+        "order": np.array(order, dtype=np.int64),
+        "start": np.array(table[0], dtype=np.int64),
+        "stop": np.array(table[1], dtype=np.int64),
+        "axis": np.array(table[2], dtype=np.int64),
+        "split": np.array(table[3], dtype=np.float64),
+        "left": np.array(table[4], dtype=np.int64),
+        "right": np.array(table[5], dtype=np.int64),
+    }
+
+
+def octree(points, leaf_size, min_extent):
+    """The contract's bucket PR octree (preorder, children in code order) as its dict."""
+    xyz = np.asarray(points, dtype=float)[:, :3]
+    if len(xyz):
+        lower, upper = xyz.min(axis=0), xyz.max(axis=0)
+        root_center, root_extent = (lower + upper) / 2, float(np.max((upper - lower) / 2))
+    else:
+        root_center, root_extent = np.zeros(3), 0.0
+    nodes = []  # [start, stop, center, extent, children]
+    order = []
+
+    def grow(indices, center, extent):
+        node = len(nodes)
+        nodes.append([len(order), None, center, extent, [-1] * 8])
+        if len(indices) <= leaf_size or extent <= min_extent:
+            order.extend(sorted(indices))
+        else:
+            codes = {}
+            for i in indices:
+                code = sum(1 << j for j in range(3) if xyz[i, j] > center[j])
+                codes.setdefault(code, []).append(i)
+            for code in sorted(codes):
+                signs = np.array([1.0 if code >> j & 1 else -1.0 for j in range(3)])
+                nodes[node][4][code] = grow(codes[code], center + signs * extent / 2, extent / 2)
+        nodes[node][1] = len(order)
+        return node
+
+    grow(list(range(len(xyz))), root_center, root_extent)
+    return {
+        "order": np.array(order, dtype=np.int64),
+        "start": np.array([n[0] for n in nodes], dtype=np.int64),
+        "stop": np.array([n[1] for n in nodes], dtype=np.int64),
+        "center": np.array([n[2] for n in nodes], dtype=np.float64).reshape(-1, 3),
+        "extent": np.array([n[3] for n in nodes], dtype=np.float64),
+        "children": np.array([n[4] for n in nodes], dtype=np.int64).reshape(-1, 8),
+    }
+
+
+# -- the contract's searches, instrumented ------------------------------------------------------
+
+
+class _Best:
+    """The k best (squared distance, index) pairs offered so far."""
+
+    def __init__(self, k):
+        self.k, self.held = k, []
+
+    def offer(self, s, index):
+        self.held = sorted([*self.held, (s, index)])[: self.k]
+
+    @property
+    def worst(self):
+        return self.held[-1][0] if len(self.held) == self.k else math.inf
+
+
+def bst_reach(keys, left, right, query, k):
+    """The nodes the contract's BST search reads for one query, and its closest call (as :func:`kdtree_reach`)."""
+    best = _Best(k)
+    reached, margin = set(), math.inf
+    stack = [(0, False)]
+    while stack:
+        node, near_done = stack.pop()
+        gap = abs(keys[node] - query)
+        go_left = query < keys[node]
+        if not near_done:
+            reached.add(node)
+            best.offer(gap, node)
+            stack.append((node, True))
+            near = left[node] if go_left else right[node]
+            if near >= 0:
+                stack.append((near, False))
+            continue
+        far = right[node] if go_left else left[node]
+        if far >= 0:
+            if math.isfinite(best.worst) and best.worst > 0:
+                margin = min(margin, abs(gap - best.worst) / best.worst)
+            if gap <= best.worst:
+                stack.append((far, False))
+    return reached, margin
+
+
+def kdtree_reach(tree, points, query, k=None, radius=None):
+    """The leaves the contract's k-d tree search reaches for one query, and its closest call.
+
+    Returns
+    -------
+    reached : set of int
+        Leaf node ids whose points the rule reads.
+    margin : float
+        The smallest relative gap ``|d2 - w2| / w2`` over the rule's
+        far-child tests: a query with a tiny margin is not used, so that a
+        correct search comparing ``|d| <= w`` instead of ``d * d <= w2``
+        (rounding apart) reaches the same leaves.
+    """
+    points = np.asarray(points, dtype=float)
+    best = _Best(k) if k is not None else None
+    bound = None if k is not None else radius**2
+    reached, margin = set(), math.inf
+
+    def visit(node):
+        nonlocal margin
+        if tree["axis"][node] < 0:
+            reached.add(node)
+            for position in range(tree["start"][node], tree["stop"][node]):
+                index = int(tree["order"][position])
+                s = float(squared_distances(points[index : index + 1], query)[0])
+                if best is not None:
+                    best.offer(s, index)
+            return
+        axis, split = tree["axis"][node], tree["split"][node]
+        diff = query[axis] - split
+        near, far = (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+        visit(near)
+        w2 = best.worst if best is not None else bound
+        if math.isfinite(w2) and w2 > 0:
+            margin = min(margin, abs(diff * diff - w2) / w2)
+        if diff * diff <= w2:
+            visit(far)
+
+    visit(0)
+    return reached, margin
+
+
+def _is_leaf(tree, node):
+    return bool(np.all(tree["children"][node] < 0))
+
+
+def _gap2(query, center, extent):
+    return float(np.sum(np.maximum(np.abs(query - center) - extent, 0.0) ** 2))
+
+
+def octree_reach(tree, points, query, k=None, radius=None):
+    """The nodes whose points the contract's octree search reads, for one query.
+
+    Radius search (``radius``): leaves tested and octants reported whole
+    (contained). kNN (``k``): leaves offered, with early termination.
+
+    Returns
+    -------
+    reached : set of int
+        Nodes whose range the search reads (a contained octant's whole
+        range counts as one node).
+    visited : list of int
+        Every node entered, in order.
+    ended_at : int or None
+        kNN: the octant after which the search ended early, else None.
+    margin : float
+        The smallest relative gap of the overlap, contains and inside tests.
+    """
+    xyz = np.asarray(points, dtype=float)[:, :3]
+    query = np.asarray(query, dtype=float)[:3]
+    reached, visited = set(), []
+    margin = [math.inf]
+    ended = [None]
+    best = _Best(k) if k is not None else None
+
+    def note(a, b):
+        if math.isfinite(b) and b > 0:
+            margin[0] = min(margin[0], abs(a - b) / b)
+
+    def radius_visit(node):
+        visited.append(node)
+        c, e = tree["center"][node], tree["extent"][node]
+        reach2 = float(np.sum((np.abs(query - c) + e) ** 2))
+        note(reach2, radius**2)
+        if reach2 <= radius**2 or _is_leaf(tree, node):
+            reached.add(node)
+            return
+        for code in range(8):
+            child = tree["children"][node, code]
+            if child >= 0:
+                g = _gap2(query, tree["center"][child], tree["extent"][child])
+                note(g, radius**2)
+                if g <= radius**2:
+                    radius_visit(child)
+
+    def knn_visit(node):
+        visited.append(node)
+        c, e = tree["center"][node], tree["extent"][node]
+        if _is_leaf(tree, node):
+            reached.add(node)
+            for position in range(tree["start"][node], tree["stop"][node]):
+                index = int(tree["order"][position])
+                best.offer(float(squared_distances(xyz[index : index + 1], query)[0]), index)
+        else:
+            own = sum(1 << j for j in range(3) if query[j] > c[j])
+            for code in [own] + [i for i in range(8) if i != own]:
+                child = tree["children"][node, code]
+                if child >= 0:
+                    g = _gap2(query, tree["center"][child], tree["extent"][child])
+                    note(g, best.worst)
+                    if g <= best.worst and knn_visit(child):
+                        return True
+        w = math.sqrt(best.worst)
+        if math.isfinite(w):
+            slack = float(np.min(e - (np.abs(query - c) + w)))
+            if e > 0:
+                margin[0] = min(margin[0], abs(slack) / e)
+        if np.all(np.abs(query - c) + w < e):
+            ended[0] = node
+            return True
+        return False
+
+    if k is not None:
+        knn_visit(0)
+    else:
+        radius_visit(0)
+    return reached, visited, ended[0], margin[0]
+
+
+# -- lying trees ----------------------------------------------------------------------------------
+
+
+def decoy_points(points, tree, reached, query, nearest, rng, radius=None):
+    """``points`` with one point of every unreached node moved next to ``query``.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, D)
+    tree : dict
+        A k-d tree or octree of ``points``.
+    reached : set of int
+        The nodes the rule reads (:func:`kdtree_reach`, :func:`octree_reach`).
+    query : ndarray, shape (D,)
+    nearest : float
+        The true nearest distance (> 0): decoys land well inside it.
+    rng : numpy.random.Generator
+    radius : float, optional
+        For a radius search: decoys land inside it as well.
+
+    Returns
+    -------
+    moved : ndarray, shape (N, D)
+        The lying cloud (every other point unchanged).
+    decoys : ndarray of int64
+        The moved points' indices.
+    """
+    leaves = _leaves(tree)
+    covered = set()
+    for node in reached:
+        covered.update(range(tree["start"][node], tree["stop"][node]))
+    moved = np.array(points, dtype=float)
+    decoys = []
+    scale = DECOY_FRACTION * min(nearest, radius if radius else math.inf)
+    for leaf in leaves:
+        positions = [p for p in range(tree["start"][leaf], tree["stop"][leaf]) if p not in covered]
+        if not positions:
+            continue
+        index = int(tree["order"][positions[0]])
+        direction = rng.standard_normal(moved.shape[1])
+        direction /= np.linalg.norm(direction)
+        moved[index] = query + direction * scale * (1 + len(decoys) / (2 * len(leaves)))
+        decoys.append(index)
+    return moved, np.array(decoys, dtype=np.int64)
+
+
+def _leaves(tree):
+    if "axis" in tree:
+        return [int(i) for i in np.flatnonzero(tree["axis"] < 0)]
+    return [int(i) for i in np.flatnonzero(np.all(tree["children"] < 0, axis=1))]

@@ -1,0 +1,550 @@
+"""Graded tests of lecture 2's nearest-neighbour search (``pcl_course/nn.py``).
+
+Expected neighbours come from brute force (every distance, sorted by
+(squared distance, index) with ``np.lexsort``); builds are checked rule by
+rule (``grading/treechecks.py``), each failure naming the rule, and against
+hand-built examples. The searches run on trees the grader builds
+(``grading/trees.py``, in the instructors' grader): a wrong build costs its
+own points once. In the student release that module is absent, so these
+tests search your own build, after checking it.
+
+The structure tests (does the search read only the nodes its rule reaches?)
+are hidden: ``tests/hidden/test_nn_hidden.py``.
+"""
+
+import numpy as np
+import pytest
+
+from grading.checks import check_array, raises
+from grading.treechecks import check_bst, check_csr, check_kdtree, check_knn, check_octree
+
+try:  # the instructors' grader (Gradescope, batch): its own trees
+    from grading import trees as grader_trees
+except ImportError:  # the student release: your own build, checked first
+    grader_trees = None
+
+
+# -- data and brute force ---------------------------------------------------------------------
+
+
+def cube(n, seed, dim=3):
+    return np.random.default_rng(seed).uniform(-1.0, 1.0, size=(n, dim))
+
+
+def scan_like(n, seed):
+    """A lidar-like cloud: rings on the ground (density falling with range) and a wall, in metres."""
+    rng = np.random.default_rng(seed)
+    n_ground = n * 3 // 4
+    elevation = rng.choice(np.radians(np.linspace(-24.0, -2.0, 16)), n_ground)
+    radius = 1.73 / np.tan(-elevation)
+    azimuth = rng.uniform(0, 2 * np.pi, n_ground)
+    ground = np.column_stack([radius * np.cos(azimuth), radius * np.sin(azimuth), rng.normal(-1.73, 0.02, n_ground)])
+    wall = np.column_stack(
+        [rng.normal(8.0, 0.02, n - n_ground), rng.uniform(-6, 6, n - n_ground), rng.uniform(-1.7, 1.5, n - n_ground)]
+    )
+    return np.vstack([ground, wall])
+
+
+def grid(side, dim=3):
+    """Integer grid points: many exact ties."""
+    axes = np.meshgrid(*[np.arange(float(side))] * dim, indexing="ij")
+    return np.stack(axes, axis=-1).reshape(-1, dim)
+
+
+def squared(points, query):
+    total = np.zeros(len(points))
+    for j in range(points.shape[1]):
+        total += (points[:, j] - query[j]) ** 2
+    return total
+
+
+def brute_knn(points, queries, k):
+    indices = np.empty((len(queries), k), dtype=np.int64)
+    for i, q in enumerate(queries):
+        indices[i] = np.lexsort((np.arange(len(points)), squared(points, q)))[:k]
+    distances = np.sqrt(np.array([squared(points[row], q) for row, q in zip(indices, queries)]).reshape(-1, k))
+    return indices, distances
+
+
+def brute_radius(points, queries, radius):
+    rows = []
+    for q in queries:
+        s = squared(points, q)
+        inside = np.flatnonzero(s <= radius**2)
+        order = inside[np.lexsort((inside, s[inside]))]
+        rows.append((order, np.sqrt(s[order])))
+    return rows
+
+
+# -- the trees searched -------------------------------------------------------------------------
+
+
+def kd_tree(impl, points, leaf_size):
+    if grader_trees is not None:
+        return grader_trees.kdtree(points, leaf_size)
+    tree = impl.kdtree_build(points, leaf_size)
+    try:
+        check_kdtree(tree, points, leaf_size)
+    except AssertionError as exc:
+        raise AssertionError(f"locally this search runs on your own kdtree_build, which is wrong: {exc}") from None
+    return tree
+
+
+def oc_tree(impl, points, leaf_size, min_extent=1e-3):
+    if grader_trees is not None:
+        return grader_trees.octree(points, leaf_size, min_extent)
+    tree = impl.octree_build(points, leaf_size, min_extent)
+    try:
+        check_octree(tree, points, leaf_size, min_extent)
+    except AssertionError as exc:
+        raise AssertionError(f"locally this search runs on your own octree_build, which is wrong: {exc}") from None
+    return tree
+
+
+# -- knn_result_set -----------------------------------------------------------------------------
+
+
+@pytest.mark.grades("knn_result_set")
+@pytest.mark.points(2)
+def test_knn_result_set_hand_worked(impl):
+    # Offers (3, 10), (1, 11), (2, 12), (1, 9) to k = 2: (2, 12) evicts (3, 10); (1, 9) evicts (2, 12)
+    # because (1, 9) < (2, 12); it also goes before (1, 11), on the index.
+    indices, distances, worst = impl.knn_result_set(np.array([3.0, 1.0, 2.0, 1.0]), np.array([10, 11, 12, 9]), 2)
+    check_array(indices, "indices", shape=(2,), dtype="int64")
+    check_array(worst, "worst", shape=(4,))
+    assert indices.tolist() == [9, 11], f"expected [9, 11] (ties by the lower index), got {indices.tolist()}"
+    assert distances.tolist() == [1.0, 1.0]
+    assert worst.tolist() == [np.inf, 3.0, 2.0, 1.0], f"worst after each offer: expected [inf, 3, 2, 1], got {worst}"
+
+
+@pytest.mark.grades("knn_result_set")
+@pytest.mark.points(3)
+def test_knn_result_set_matches_sorting_with_ties(impl):
+    rng = np.random.default_rng(7)
+    for n, k in ((50, 5), (200, 17), (30, 30), (10, 1)):
+        distances = rng.integers(0, 8, n).astype(float) / 4  # many ties
+        indices = rng.permutation(1000)[:n]
+        got_indices, got_distances, worst = impl.knn_result_set(distances, indices, k)
+        rank = np.lexsort((indices, distances))[:k]
+        assert got_indices.tolist() == indices[rank].tolist(), (
+            f"n={n}, k={k}: expected the k smallest (distance, index) pairs, ascending; the lower index wins ties"
+        )
+        assert np.array_equal(got_distances, distances[rank])
+        expected_worst = [np.inf if j + 1 < k else np.sort(distances[: j + 1])[k - 1] for j in range(n)]
+        assert np.array_equal(worst, expected_worst), f"n={n}, k={k}: worst must be the k-th best after each offer"
+
+
+@pytest.mark.grades("knn_result_set")
+@pytest.mark.points(1)
+def test_knn_result_set_with_fewer_candidates_than_k_is_not_padded(impl):
+    indices, distances, worst = impl.knn_result_set(np.array([0.5, 0.25]), np.array([4, 2]), 5)
+    assert indices.tolist() == [2, 4] and distances.tolist() == [0.25, 0.5], "fewer than k: return them all, sorted"
+    assert np.all(np.isinf(worst)), "worst is inf while fewer than k are held"
+    empty = impl.knn_result_set(np.empty(0), np.empty(0, dtype=np.int64), 3)
+    assert [len(a) for a in empty] == [0, 0, 0], "no candidates: three empty arrays"
+
+
+@pytest.mark.grades("knn_result_set")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_knn_result_set_rejects_bad_input(impl):
+    with raises(ValueError) as excinfo:
+        impl.knn_result_set(np.array([1.0, -1.0]), np.array([0, 1]), 1)
+    assert "distances" in str(excinfo.value)
+    with raises(ValueError):
+        impl.knn_result_set(np.array([1.0, np.nan]), np.array([0, 1]), 1)
+    with raises(ValueError) as excinfo:
+        impl.knn_result_set(np.array([1.0, 2.0]), np.array([0]), 1)
+    assert "indices" in str(excinfo.value)
+    with raises(ValueError) as excinfo:
+        impl.knn_result_set(np.array([1.0]), np.array([0]), 0)
+    assert "k" in str(excinfo.value)
+
+
+# -- bst_build, bst_knn ----------------------------------------------------------------------------
+
+
+@pytest.mark.grades("bst_build")
+@pytest.mark.points(2)
+def test_bst_build_hand_worked(impl):
+    # 5 is the root; 3 < 5 goes left; 8 right; the second 5 is not < 5: right of the root, then left of 8.
+    left, right = impl.bst_build(np.array([5.0, 3.0, 8.0, 5.0]))
+    check_array(left, "left", shape=(4,), dtype="int64")
+    assert left.tolist() == [1, -1, 3, -1] and right.tolist() == [2, -1, -1, -1], (
+        f"expected left [1, -1, 3, -1], right [2, -1, -1, -1] (equal keys go right), got {left}, {right}"
+    )
+
+
+@pytest.mark.grades("bst_build")
+@pytest.mark.points(3)
+def test_bst_build_inserts_in_order_with_duplicates(impl):
+    rng = np.random.default_rng(11)
+    for n in (1, 2, 40, 500):
+        keys = rng.integers(0, max(n // 3, 1), n).astype(float)
+        left, right = impl.bst_build(keys)
+        check_bst(left, right, keys)
+
+
+@pytest.mark.grades("bst_build")
+@pytest.mark.points(2)
+def test_bst_build_of_sorted_keys_is_a_path(impl):
+    keys = np.arange(3000.0)  # depth 2999: beyond Python's recursion limit
+    left, right = impl.bst_build(keys)
+    assert np.all(left == -1) and right.tolist() == [*range(1, 3000), -1], (
+        "sorted keys make a path of right children; build it with a loop, not one recursive call per level"
+    )
+
+
+@pytest.mark.grades("bst_build")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_bst_build_empty_and_bad_keys(impl):
+    left, right = impl.bst_build(np.empty(0))
+    check_array(left, "left", shape=(0,), dtype="int64")
+    check_array(right, "right", shape=(0,), dtype="int64")
+    with raises(ValueError) as excinfo:
+        impl.bst_build(np.array([1.0, np.inf]))
+    assert "keys" in str(excinfo.value)
+
+
+def bst_of(impl, keys):
+    if grader_trees is not None:
+        return grader_trees.bst(keys)
+    left, right = impl.bst_build(keys)
+    check_bst(left, right, keys)
+    return left, right
+
+
+@pytest.mark.grades("bst_knn")
+@pytest.mark.points(3)
+def test_bst_knn_matches_brute_force(impl):
+    rng = np.random.default_rng(12)
+    keys = np.round(rng.normal(0, 10, 400), 1)  # ties among keys and distances
+    left, right = bst_of(impl, keys)
+    for query, k in ((0.05, 1), (3.0, 7), (-40.0, 5), (12.35, 400), (rng.normal(0, 10), 25)):
+        indices, distances = impl.bst_knn(keys, left, right, query, k)
+        expected = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
+        check_array(indices, "indices", shape=(k,), dtype="int64")
+        assert indices.tolist() == expected.tolist(), (
+            f"query {query:g}, k={k}: got {indices[:6]}, expected {expected[:6]}: "
+            "the k nearest by |key - query|, ties by the lower index"
+        )
+        assert np.allclose(distances, np.abs(keys[expected] - query), rtol=0, atol=1e-12)
+
+
+@pytest.mark.grades("bst_knn")
+@pytest.mark.points(1)
+def test_bst_knn_on_a_path_of_sorted_keys(impl):
+    keys = np.arange(3000.0) / 2
+    left, right = bst_of(impl, keys)
+    indices, distances = impl.bst_knn(keys, left, right, 1400.3, 3)
+    assert indices.tolist() == [2801, 2800, 2802], "a path of depth 2999: search it with a loop or an explicit stack"
+
+
+@pytest.mark.grades("bst_knn")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_bst_knn_rejects_bad_input(impl):
+    keys = np.array([5.0, 3.0, 8.0])
+    left, right = np.array([1, -1, -1]), np.array([2, -1, -1])
+    with raises(ValueError) as excinfo:
+        impl.bst_knn(keys, left, right, 4.0, 4)
+    assert "k" in str(excinfo.value)
+    with raises(ValueError):
+        impl.bst_knn(keys, np.array([1, 1, -1]), right, 4.0, 1)  # node 1 is its own child
+    with raises(ValueError):
+        impl.bst_knn(keys, left, right, np.nan, 1)
+
+
+# -- kdtree_build -------------------------------------------------------------------------------
+
+
+@pytest.mark.grades("kdtree_build")
+@pytest.mark.points(2)
+def test_kdtree_build_hand_worked(impl):
+    # Root: x of (0, 0), (2, 5), (4, 1) is 0, 2, 4; m = ceil(3/2) = 2 go left; split (2 + 4) / 2 = 3.
+    # Node 1 (depth 1, axis y): (0, 0) and (2, 5), split 2.5; nodes 2, 3 its leaves; node 4 the root's right.
+    tree = impl.kdtree_build(np.array([[0.0, 0.0], [4.0, 1.0], [2.0, 5.0]]), 1)
+    assert isinstance(tree, dict), "kdtree_build returns a dict"
+    expected = {
+        "order": [0, 2, 1],
+        "start": [0, 0, 0, 1, 2],
+        "stop": [3, 2, 1, 2, 3],
+        "axis": [0, 1, -1, -1, -1],
+        "left": [1, 2, -1, -1, -1],
+        "right": [4, 3, -1, -1, -1],
+    }
+    for key, value in expected.items():
+        got = np.asarray(tree.get(key)).tolist()
+        assert got == value, f"tree[{key!r}]: expected {value}, got {got}"
+    split = np.asarray(tree["split"])
+    assert split[:2].tolist() == [3.0, 2.5] and np.all(np.isnan(split[2:])), f"split: expected [3, 2.5, nan x3], {split}"
+
+
+@pytest.mark.grades("kdtree_build")
+@pytest.mark.points(4)
+def test_kdtree_build_follows_the_median_rule(impl):
+    for points, leaf_size in (
+        (cube(1000, 21), 16),
+        (cube(777, 22, dim=2), 5),
+        (scan_like(1500, 23), 8),
+        (cube(300, 24, dim=5), 3),
+        (np.round(cube(400, 25), 1), 4),  # equal coordinates on both sides of a split
+    ):
+        check_kdtree(impl.kdtree_build(points, leaf_size), points, leaf_size)
+
+
+@pytest.mark.grades("kdtree_build")
+@pytest.mark.points(2)
+def test_kdtree_build_with_duplicates_and_leaf_size_one(impl):
+    duplicates = np.vstack([np.zeros((40, 3)), np.ones((25, 3)), cube(10, 26)])
+    check_kdtree(impl.kdtree_build(duplicates, 4), duplicates, 4)  # terminates: halves are never empty
+    points = cube(64, 27)
+    check_kdtree(impl.kdtree_build(points, 1), points, 1)
+
+
+@pytest.mark.grades("kdtree_build")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kdtree_build_edge_cases_and_bad_input(impl):
+    empty = impl.kdtree_build(np.empty((0, 3)), 16)
+    check_kdtree(empty, np.empty((0, 3)), 16)
+    points = cube(10, 28)
+    check_kdtree(impl.kdtree_build(points, 10), points, 10)  # one leaf
+    with raises(ValueError) as excinfo:
+        impl.kdtree_build(points, 0)
+    assert "leaf_size" in str(excinfo.value)
+    with raises(ValueError):
+        impl.kdtree_build(np.array([[0.0, np.nan]]), 1)
+
+
+# -- kdtree_knn, kdtree_radius -------------------------------------------------------------------
+
+
+@pytest.mark.grades("kdtree_knn")
+@pytest.mark.points(4)
+def test_kdtree_knn_matches_brute_force(impl):
+    for points, queries, k, leaf in (
+        (cube(2000, 31), cube(150, 32), 8, 16),
+        (scan_like(2000, 33), scan_like(150, 34) + 0.05, 5, 8),
+        (cube(1500, 35, dim=2), cube(100, 36, dim=2) * 1.2, 12, 4),
+    ):
+        tree = kd_tree(impl, points, leaf)
+        check_knn(*impl.kdtree_knn(tree, points, queries, k), *brute_knn(points, queries, k), "kdtree_knn")
+
+
+@pytest.mark.grades("kdtree_knn")
+@pytest.mark.points(2)
+def test_kdtree_knn_self_far_and_large_coordinate_queries(impl):
+    points = cube(1000, 37) + [4.0e6, -2.0e6, 1.0e3]  # UTM-like coordinates
+    tree = kd_tree(impl, points, 8)
+    queries = np.vstack([points[:50], points[:20] + [50.0, 0, 0]])
+    check_knn(*impl.kdtree_knn(tree, points, queries, 6), *brute_knn(points, queries, 6), "kdtree_knn")
+    indices, distances = impl.kdtree_knn(tree, points, points[:5], 1)
+    assert indices[:, 0].tolist() == list(range(5)) and np.all(distances == 0), "a point is its own nearest"
+
+
+@pytest.mark.grades("kdtree_knn")
+@pytest.mark.points(3)
+def test_kdtree_knn_on_a_grid_with_exact_ties(impl):
+    points = grid(7)
+    tree = kd_tree(impl, points, 4)
+    queries = np.vstack([points[::13], points[::17] + 0.5])
+    for k in (1, 7, 19, 27):  # 7: the point and its 6 face neighbours at distance 1, ties everywhere
+        check_knn(*impl.kdtree_knn(tree, points, queries, k), *brute_knn(points, queries, k), f"kdtree_knn, k={k}")
+
+
+@pytest.mark.grades("kdtree_knn")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kdtree_knn_bad_input_and_no_queries(impl):
+    points = cube(50, 38)
+    tree = kd_tree(impl, points, 4)
+    indices, distances = impl.kdtree_knn(tree, points, np.empty((0, 3)), 3)
+    check_array(indices, "indices", shape=(0, 3), dtype="int64")
+    with raises(ValueError) as excinfo:
+        impl.kdtree_knn(tree, points, points[:2], 51)
+    assert "k" in str(excinfo.value)
+    with raises(ValueError) as excinfo:
+        impl.kdtree_knn(tree, points, np.zeros((2, 2)), 1)
+    assert "queries" in str(excinfo.value)
+    with raises(ValueError) as excinfo:
+        impl.kdtree_knn({"order": tree["order"]}, points, points[:2], 1)
+    assert "tree" in str(excinfo.value)
+
+
+@pytest.mark.grades("kdtree_radius")
+@pytest.mark.points(3)
+def test_kdtree_radius_matches_brute_force(impl):
+    for points, queries, radius, leaf in (
+        (cube(2000, 41), cube(100, 42), 0.2, 16),
+        (scan_like(2000, 43), scan_like(100, 44), 0.5, 8),
+        (cube(1000, 45, dim=2), cube(80, 46, dim=2), 0.1, 3),
+    ):
+        tree = kd_tree(impl, points, leaf)
+        check_csr(impl.kdtree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
+
+
+@pytest.mark.grades("kdtree_radius")
+@pytest.mark.points(2)
+def test_kdtree_radius_zero_finds_duplicates_and_a_large_radius_finds_all(impl):
+    points = np.vstack([cube(300, 47), cube(300, 47)[:40]])  # 40 exact duplicates
+    tree = kd_tree(impl, points, 8)
+    check_csr(impl.kdtree_radius(tree, points, points[:60], 0.0), brute_radius(points, points[:60], 0.0))
+    check_csr(impl.kdtree_radius(tree, points, points[:3], 10.0), brute_radius(points, points[:3], 10.0))
+
+
+@pytest.mark.grades("kdtree_radius")
+@pytest.mark.points(2)
+def test_kdtree_radius_on_a_grid_with_an_integer_radius(impl):
+    points = grid(6)
+    tree = kd_tree(impl, points, 2)
+    queries = points[::7]
+    for radius in (1.0, 2.0):  # neighbours exactly at the radius, and on split planes
+        check_csr(impl.kdtree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
+
+
+@pytest.mark.grades("kdtree_radius")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kdtree_radius_rejects_bad_radii(impl):
+    points = cube(30, 48)
+    tree = kd_tree(impl, points, 4)
+    for radius in (-0.1, np.nan, np.inf):
+        with raises(ValueError) as excinfo:
+            impl.kdtree_radius(tree, points, points[:2], radius)
+        assert "radius" in str(excinfo.value)
+
+
+# -- octree_build -------------------------------------------------------------------------------
+
+
+@pytest.mark.grades("octree_build")
+@pytest.mark.points(2)
+def test_octree_build_hand_worked(impl):
+    # Root: centre (1, 1, 1), extent 1. (1, 0, 0) lies on the plane x = 1: code 0, with (0, 0, 0); (2, 2, 2): code 7.
+    # Node 1 (centre 0.5, extent 0.5) splits (0, 0, 0) -> code 0 and (1, 0, 0) -> code 1.
+    tree = impl.octree_build(np.array([[0.0, 0, 0], [2.0, 2, 2], [1.0, 0, 0]]), 1)
+    assert isinstance(tree, dict), "octree_build returns a dict"
+    assert np.asarray(tree["children"][0]).tolist() == [1, -1, -1, -1, -1, -1, -1, 4], (
+        f"root's children: expected [1, -1, ..., -1, 4], got {tree['children'][0]}"
+    )
+    assert np.asarray(tree["extent"]).tolist() == [1.0, 0.5, 0.25, 0.25, 0.5]
+    assert np.asarray(tree["order"]).tolist() == [0, 2, 1]
+    assert np.asarray(tree["center"][3]).tolist() == [0.75, 0.25, 0.25]
+
+
+@pytest.mark.grades("octree_build")
+@pytest.mark.points(4)
+def test_octree_build_follows_the_rules(impl):
+    for points, leaf_size in ((cube(1000, 51), 8), (scan_like(1500, 52), 16), (np.round(cube(500, 53), 1), 2)):
+        check_octree(impl.octree_build(points, leaf_size, 1e-3), points, leaf_size, 1e-3)
+
+
+@pytest.mark.grades("octree_build")
+@pytest.mark.points(2)
+def test_octree_build_root_cube_is_the_bounding_cube(impl):
+    rng = np.random.default_rng(54)
+    skewed = np.vstack([rng.normal(0, 0.05, (300, 3)), [[10.0, 0.2, -0.1]], rng.uniform(-1, 1, (20, 3))])
+    skewed = np.hstack([skewed, rng.uniform(size=(len(skewed), 1))])  # a fourth column, not a coordinate
+    tree = impl.octree_build(skewed, 8)
+    check_octree(tree, skewed, 8, 1e-3)
+
+
+@pytest.mark.grades("octree_build")
+@pytest.mark.points(2)
+def test_octree_build_stops_at_min_extent(impl):
+    points = np.vstack([np.full((100, 3), 0.25), cube(30, 55)])
+    tree = impl.octree_build(points, 4, 0.01)
+    check_octree(tree, points, 4, 0.01)
+    same = np.ones((50, 3))
+    check_octree(impl.octree_build(same, 4), same, 4, 1e-3)  # extent 0 at the root: one leaf
+
+
+@pytest.mark.grades("octree_build")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_octree_build_edge_cases_and_bad_input(impl):
+    tree = impl.octree_build(np.empty((0, 3)))
+    check_octree(tree, np.empty((0, 3)), 8, 1e-3)
+    check_octree(impl.octree_build(np.ones((1, 3))), np.ones((1, 3)), 8, 1e-3)
+    with raises(ValueError) as excinfo:
+        impl.octree_build(cube(10, 56), 1, 0.0)
+    assert "min_extent" in str(excinfo.value)
+    with raises(ValueError) as excinfo:
+        impl.octree_build(cube(10, 56)[:, :2])
+    assert "points" in str(excinfo.value)
+
+
+# -- octree_radius, octree_knn -------------------------------------------------------------------
+
+
+@pytest.mark.grades("octree_radius")
+@pytest.mark.points(4)
+def test_octree_radius_matches_brute_force(impl):
+    for points, queries, radius, leaf in (
+        (cube(2000, 61), cube(100, 62) * 1.3, 0.25, 8),  # some queries outside the root cube
+        (scan_like(2000, 63), scan_like(100, 64), 0.6, 16),
+        (cube(1000, 65), cube(30, 66), 1.5, 4),  # large balls: whole octants inside
+    ):
+        tree = oc_tree(impl, points, leaf)
+        check_csr(impl.octree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
+
+
+@pytest.mark.grades("octree_radius")
+@pytest.mark.points(2)
+def test_octree_radius_on_a_grid(impl):
+    points = grid(8)
+    tree = oc_tree(impl, points, 2)
+    queries = np.vstack([points[::11], points[::23] + 0.5])
+    for radius in (0.0, 1.0, 1.5, 3.0):  # points exactly at the radius, on centre planes and faces
+        check_csr(impl.octree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
+
+
+@pytest.mark.grades("octree_radius")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_octree_radius_rejects_bad_input(impl):
+    points = cube(30, 67)
+    tree = oc_tree(impl, points, 4)
+    with raises(ValueError) as excinfo:
+        impl.octree_radius(tree, points, points[:2], -1.0)
+    assert "radius" in str(excinfo.value)
+    indptr, indices, distances = impl.octree_radius(tree, points, np.empty((0, 3)), 0.5)
+    assert indptr.tolist() == [0] and len(indices) == 0, "no queries: indptr [0] and empty rows"
+
+
+@pytest.mark.grades("octree_knn")
+@pytest.mark.points(4)
+def test_octree_knn_matches_brute_force(impl):
+    for points, queries, k, leaf in (
+        (cube(2000, 71), cube(120, 72) * 1.2, 8, 8),
+        (scan_like(2000, 73), scan_like(120, 74), 5, 16),
+        (cube(300, 75), cube(20, 76), 300, 4),  # k = N
+    ):
+        tree = oc_tree(impl, points, leaf)
+        check_knn(*impl.octree_knn(tree, points, queries, k), *brute_knn(points, queries, k), "octree_knn")
+
+
+@pytest.mark.grades("octree_knn")
+@pytest.mark.points(2)
+def test_octree_knn_on_a_grid_with_exact_ties(impl):
+    points = grid(8)
+    tree = oc_tree(impl, points, 2)
+    queries = np.vstack([points[::9], points[::19] + 0.5])
+    for k in (1, 7, 19):
+        check_knn(*impl.octree_knn(tree, points, queries, k), *brute_knn(points, queries, k), f"octree_knn, k={k}")
+
+
+@pytest.mark.grades("octree_knn")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_octree_knn_rejects_bad_input(impl):
+    points = cube(30, 77)
+    tree = oc_tree(impl, points, 4)
+    with raises(ValueError) as excinfo:
+        impl.octree_knn(tree, points, points[:2], 0)
+    assert "k" in str(excinfo.value)
+    with raises(ValueError) as excinfo:
+        impl.octree_knn(tree, points[:20], points[:2], 1)  # a tree of 30 points
+    assert "tree" in str(excinfo.value)

@@ -1,0 +1,303 @@
+"""Hidden graded tests of lecture 2 (``pcl_course/nn.py``): the searches' structure, on lying trees.
+
+Each structure test hands the submission a tree built by the grader
+(``grading/trees.py``) whose unreached nodes lie: one point of every node
+the contract's rule does not reach is moved next to the query. A search
+that follows the rule, or prunes more, never reads them and returns the
+brute-force answer of the original cloud; a search that reads more
+(brute force, a library, no pruning, the far side first, a too-weak test)
+returns a decoy. The octree's shortcuts get lying geometry of their own:
+children placed far away under an octant the ball contains, and a sibling
+placed on the query after the octant where the search must end.
+"""
+
+import numpy as np
+import pytest
+
+from grading import trees
+from grading.errors import CheckFailed
+from grading.treechecks import check_csr, check_kdtree, check_knn, check_octree
+
+pytestmark = pytest.mark.hidden
+
+MARGIN = 1e-6  # queries whose rule decisions are closer than this (relative) to a tie are not used
+N_QUERIES = 6
+
+
+def uniform(n, seed, dim=3):
+    return np.random.default_rng(seed).uniform(0.0, 1.0, size=(n, dim))
+
+
+def structure_failure(what):
+    return CheckFailed(
+        f"{what}: your search read a node that the contract's rule never reaches, and returned a decoy planted "
+        "there (brute force, a library, no pruning, the far side first, or a weaker test than the rule's)",
+        rule=f"{what} reads nodes its rule does not reach",
+    )
+
+
+def fair_queries(points, seed, reach, count=N_QUERIES):
+    """Random queries in the cloud's box whose rule decisions are clear of ties."""
+    rng = np.random.default_rng(seed)
+    lower, upper = points.min(axis=0), points.max(axis=0)
+    chosen = []
+    while len(chosen) < count:
+        query = rng.uniform(lower, upper)
+        reached, margin = reach(query)
+        if margin > MARGIN:
+            chosen.append((query, reached))
+    return chosen
+
+
+# -- knn_result_set, BST ---------------------------------------------------------------------------
+
+
+@pytest.mark.grades("knn_result_set")
+@pytest.mark.points(2)
+def test_knn_result_set_hidden_ties_at_the_kth_place_and_large_distances(impl):
+    distances = np.array([5.0, 2.0, 2.0, 7.0, 2.0, 1e12, 3e11])
+    indices = np.array([40, 31, 12, 9, 30, 1, 2])
+    got, got_distances, worst = impl.knn_result_set(distances, indices, 3)
+    rank = np.lexsort((indices, distances))[:3]
+    assert got.tolist() == indices[rank].tolist(), "ties at the k-th place: the lower index stays"
+    got, _, worst = impl.knn_result_set(distances[5:], indices[5:], 1)
+    assert got.tolist() == [2] and worst.tolist() == [1e12, 3e11], "distances above any sentinel (no 1e10)"
+
+
+@pytest.mark.grades("bst_build")
+@pytest.mark.points(1)
+def test_bst_build_hidden_many_equal_keys(impl):
+    keys = np.array([2.0] * 30 + [1.0] * 10 + [3.0] * 10)
+    left, right = impl.bst_build(keys)
+    expected = trees.bst(keys)
+    assert left.tolist() == expected[0].tolist() and right.tolist() == expected[1].tolist(), (
+        "equal keys go right"
+    )
+
+
+@pytest.mark.grades("bst_knn")
+@pytest.mark.points(3)
+def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
+    rng = np.random.default_rng(81)
+    keys = rng.uniform(0, 1000, 2000)
+    left, right = trees.bst(keys)
+    for k in (1, 5):
+        for query in rng.uniform(100, 900, 4):
+            reached, margin = trees.bst_reach(keys, left, right, query, k)
+            if margin < MARGIN:
+                continue
+            nearest = np.sort(np.abs(keys - query))[0]
+            lying = keys.copy()
+            unreached = np.setdiff1d(np.arange(len(keys)), sorted(reached))
+            lying[unreached] = query + nearest * 1e-3 * (1 + np.arange(len(unreached)) / len(unreached))
+            indices, _ = impl.bst_knn(lying, left, right, float(query), k)
+            expected = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
+            if indices.tolist() != expected.tolist():
+                raise structure_failure("bst_knn")
+
+
+# -- k-d tree -------------------------------------------------------------------------------------
+
+
+@pytest.mark.grades("kdtree_build")
+@pytest.mark.points(3)
+def test_kdtree_build_hidden_exact_on_new_clouds(impl):
+    rng = np.random.default_rng(82)
+    for points, leaf_size in (
+        (rng.integers(0, 5, (301, 2)).astype(float), 3),  # heavy ties, odd sizes
+        (rng.normal(size=(999, 3)) * [10, 1, 0.1], 16),
+        (rng.uniform(size=(33, 1)), 1),
+    ):
+        tree = impl.kdtree_build(points, leaf_size)
+        check_kdtree(tree, points, leaf_size)
+        expected = trees.kdtree(points, leaf_size)
+        for key in expected:
+            assert np.array_equal(tree[key], expected[key], equal_nan=True), f"kdtree_build: {key} differs"
+
+
+def kd_decoy_case(points, leaf_size, seed, k=None, radius=None):
+    tree = trees.kdtree(points, leaf_size)
+    rng = np.random.default_rng(seed)
+    for query, reached in fair_queries(points, seed, lambda q: trees.kdtree_reach(tree, points, q, k=k, radius=radius)):
+        nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
+        lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
+        assert len(decoys) > len(reached), "the test needs most leaves unreached"
+        yield tree, query, lying
+
+
+@pytest.mark.grades("kdtree_knn")
+@pytest.mark.points(8)
+def test_kdtree_knn_hidden_reads_only_what_its_rule_reaches(impl):
+    points = uniform(4096, 83)
+    for k in (1, 8):
+        for tree, query, lying in kd_decoy_case(points, 8, 84 + k, k=k):
+            indices, distances = impl.kdtree_knn(tree, lying, query[None], k)
+            try:
+                check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "kdtree_knn")
+            except CheckFailed:
+                raise structure_failure("kdtree_knn") from None
+
+
+@pytest.mark.grades("kdtree_knn")
+@pytest.mark.points(2)
+def test_kdtree_knn_hidden_float32_input_and_k_equal_n(impl):
+    points = uniform(500, 85).astype(np.float32)
+    tree = trees.kdtree(points.astype(float), 8)
+    queries = uniform(20, 86).astype(np.float32)
+    expected = [trees.brute_knn(points.astype(float), q, 500) for q in queries.astype(float)]
+    indices, distances = impl.kdtree_knn(tree, points, queries, 500)
+    check_knn(indices, distances, np.array([e[0] for e in expected]), np.array([e[1] for e in expected]))
+
+
+@pytest.mark.grades("kdtree_radius")
+@pytest.mark.points(4)
+def test_kdtree_radius_hidden_reads_only_what_its_rule_reaches(impl):
+    points = uniform(4096, 87)
+    for tree, query, lying in kd_decoy_case(points, 8, 88, radius=0.05):
+        result = impl.kdtree_radius(tree, lying, query[None], 0.05)
+        try:
+            check_csr(result, [trees.brute_radius(points, query, 0.05)], "kdtree_radius")
+        except CheckFailed:
+            raise structure_failure("kdtree_radius") from None
+
+
+# -- octree ---------------------------------------------------------------------------------------
+
+
+@pytest.mark.grades("octree_build")
+@pytest.mark.points(4)
+def test_octree_build_hidden_exact_on_new_clouds(impl):
+    rng = np.random.default_rng(89)
+    for points, leaf_size, min_extent in (
+        (rng.integers(0, 9, (400, 3)).astype(float), 2, 1e-3),  # points on centre planes
+        (np.vstack([rng.normal(size=(500, 3)) * [20, 2, 0.5], np.full((30, 3), 0.125)]), 8, 0.05),
+        (rng.uniform(size=(2, 4)), 1, 1e-3),
+    ):
+        tree = impl.octree_build(points, leaf_size, min_extent)
+        check_octree(tree, points, leaf_size, min_extent)
+        expected = trees.octree(points, leaf_size, min_extent)
+        for key in expected:
+            assert np.array_equal(tree[key], expected[key]), f"octree_build: {key} differs"
+
+
+def oc_decoy_case(points, leaf_size, seed, k=None, radius=None):
+    tree = trees.octree(points, leaf_size, 1e-3)
+    rng = np.random.default_rng(seed)
+
+    def reach(query):
+        reached, _, _, margin = trees.octree_reach(tree, points, query, k=k, radius=radius)
+        return reached, margin
+
+    for query, reached in fair_queries(points, seed, reach):
+        nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
+        lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
+        assert len(decoys) > len(reached), "the test needs most leaves unreached"
+        yield tree, query, lying
+
+
+@pytest.mark.grades("octree_radius")
+@pytest.mark.points(3)
+def test_octree_radius_hidden_reads_only_what_its_rule_reaches(impl):
+    points = uniform(4096, 90)
+    for tree, query, lying in oc_decoy_case(points, 8, 91, radius=0.06):
+        result = impl.octree_radius(tree, lying, query[None], 0.06)
+        try:
+            check_csr(result, [trees.brute_radius(points, query, 0.06)], "octree_radius")
+        except CheckFailed:
+            raise structure_failure("octree_radius") from None
+
+
+def subtree(tree, node):
+    """``node`` and every node below it."""
+    found, stack = [], [node]
+    while stack:
+        current = stack.pop()
+        found.append(current)
+        stack.extend(int(c) for c in tree["children"][current] if c >= 0)
+    return found
+
+
+@pytest.mark.grades("octree_radius")
+@pytest.mark.points(3)
+def test_octree_radius_hidden_reports_a_contained_octant_whole(impl):
+    points = uniform(4096, 92)
+    tree = trees.octree(points, 4, 1e-3)
+    rng = np.random.default_rng(93)
+    internal = [i for i in range(1, len(tree["start"])) if np.any(tree["children"][i] >= 0)]
+    used = 0
+    for node in rng.permutation(internal):
+        center, extent = tree["center"][node], tree["extent"][node]
+        query = center + rng.uniform(-0.2, 0.2, 3) * extent
+        radius = 1.02 * np.sqrt(np.sum((np.abs(query - center) + extent) ** 2))
+        reached, _, _, _ = trees.octree_reach(tree, points, query, radius=radius)
+        if node not in reached:  # an ancestor is contained too: try another
+            continue
+        lying = {key: value.copy() for key, value in tree.items()}
+        for below in subtree(tree, node)[1:]:
+            lying["center"][below] = center + 1e3  # the children "are" far away: only the shortcut reports them
+        result = impl.octree_radius(lying, points, query[None], radius)
+        try:
+            check_csr(result, [trees.brute_radius(points, query, radius)], "octree_radius")
+        except CheckFailed:
+            raise CheckFailed(
+                "octree_radius: an octant that the ball contains must be reported whole, without descending "
+                "(the contains test), each point with its true distance",
+                rule="octree_radius does not report a contained octant whole",
+            ) from None
+        used += 1
+        if used == 4:
+            break
+    assert used == 4, "the test found too few contained octants"
+
+
+@pytest.mark.grades("octree_knn")
+@pytest.mark.points(4)
+def test_octree_knn_hidden_reads_only_what_its_rule_reaches(impl):
+    points = uniform(4096, 94)
+    for k in (1, 6):
+        for tree, query, lying in oc_decoy_case(points, 8, 95 + k, k=k):
+            indices, distances = impl.octree_knn(tree, lying, query[None], k)
+            try:
+                check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "octree_knn")
+            except CheckFailed:
+                raise structure_failure("octree_knn") from None
+
+
+@pytest.mark.grades("octree_knn")
+@pytest.mark.points(4)
+def test_octree_knn_hidden_ends_when_the_ball_is_inside_an_octant(impl):
+    points = uniform(4096, 96)
+    tree = trees.octree(points, 8, 1e-3)
+    rng = np.random.default_rng(97)
+    parent_of = {int(c): i for i in range(len(tree["start"])) for c in tree["children"][i] if c >= 0}
+    used = 0
+    for _ in range(200):
+        query, k = rng.uniform(0.1, 0.9, 3), int(rng.integers(1, 4))
+        _, _, ended_at, margin = trees.octree_reach(tree, points, query, k=k)
+        if ended_at is None or ended_at == 0 or margin < MARGIN:
+            continue
+        parent = parent_of[ended_at]
+        siblings = [int(c) for c in tree["children"][parent] if c >= 0 and c != ended_at]
+        if not siblings:
+            continue
+        sibling = siblings[-1]
+        lying_tree = {key: value.copy() for key, value in tree.items()}
+        for below in subtree(tree, sibling):
+            lying_tree["center"][below] = query  # it now "meets" every ball around the query
+        lying_points = points.copy()
+        nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
+        decoy = tree["order"][tree["start"][sibling]]
+        lying_points[decoy] = query + nearest * 1e-3
+        indices, distances = impl.octree_knn(lying_tree, lying_points, query[None], k)
+        try:
+            check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "octree_knn")
+        except CheckFailed:
+            raise CheckFailed(
+                "octree_knn: once an octant has been processed and the ball of the k-th distance lies strictly "
+                "inside its cube, the search must end (early termination), and the query's own child comes first",
+                rule="octree_knn does not end early, or visits children in another order",
+            ) from None
+        used += 1
+        if used == 4:
+            break
+    assert used == 4, "the test found too few queries that end early"
