@@ -11,6 +11,7 @@ IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".ipynb_checkpoints")
 # Instructors' tools and files, never in a student's copy of the grader.
 INSTRUCTOR_ONLY_GRADER = (
     "grading/mistakes",  # the catalogue of known mistakes computes right answers
+    "grading/trees.py",  # lecture 2's canonical trees and rule searches answer its exercises
     "grading/templates",  # the student repository's and Gradescope's own files
     "grading/release.py",
     "grading/gradescope.py",

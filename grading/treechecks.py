@@ -80,7 +80,9 @@ def check_kdtree(tree, points, leaf_size):
 
     def visit(node, lo, hi, depth):
         if node != expected_next[0]:
-            _fail(f"node {expected_next[0]} is expected next in preorder, the tree gives {node}", "nodes not in preorder")
+            _fail(
+                f"node {expected_next[0]} is expected next in preorder, the tree gives {node}", "nodes not in preorder"
+            )
         expected_next[0] += 1
         if node >= m_nodes:
             _fail(f"node {node} does not exist ({m_nodes} nodes)", "a child id is out of range")
@@ -101,7 +103,9 @@ def check_kdtree(tree, points, leaf_size):
                 _fail(f"leaf {node}: its points must be in increasing index, got {order[lo:hi][:6]}", "leaf order")
             return
         if tree["left"][node] < 0:
-            _fail(f"node {node} holds {size} > leaf_size = {leaf_size} points: it must be split", "a big node is a leaf")
+            _fail(
+                f"node {node} holds {size} > leaf_size = {leaf_size} points: it must be split", "a big node is a leaf"
+            )
         axis = int(tree["axis"][node])
         if axis != depth % dim:
             _fail(f"node {node} splits on axis {axis}, depth {depth} gives axis {depth % dim} (depth % D)", "axis rule")
@@ -155,7 +159,9 @@ def check_octree(tree, points, leaf_size, min_extent):
 
     def visit(node, lo, hi, center, extent):
         if node != expected_next[0]:
-            _fail(f"node {expected_next[0]} is expected next in preorder, the tree gives {node}", "nodes not in preorder")
+            _fail(
+                f"node {expected_next[0]} is expected next in preorder, the tree gives {node}", "nodes not in preorder"
+            )
         expected_next[0] += 1
         start, stop = int(tree["start"][node]), int(tree["stop"][node])
         if (start, stop) != (lo, hi):
@@ -249,7 +255,9 @@ def check_csr(result, expected_rows, what="radius search"):
             if set(got.tolist()) == set(rows.tolist()):
                 hint = "the right neighbours in another order: sort each row by (squared distance, index)"
             elif len(got) < len(rows):
-                hint = "neighbours are missing: the test is inclusive (<= radius ** 2), and prune only what cannot hold one"
+                hint = (
+                    "neighbours are missing: the test is inclusive (<= radius ** 2); prune only what cannot hold one"
+                )
             else:
                 hint = "extra points: keep only those with squared distance <= radius ** 2"
             _fail(

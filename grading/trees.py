@@ -231,7 +231,9 @@ def kdtree_reach(tree, points, query, k=None, radius=None):
             return
         axis, split = tree["axis"][node], tree["split"][node]
         diff = query[axis] - split
-        near, far = (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+        near, far = (
+            (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+        )
         visit(near)
         w2 = best.worst if best is not None else bound
         if math.isfinite(w2) and w2 > 0:
@@ -380,3 +382,149 @@ def _leaves(tree):
     if "axis" in tree:
         return [int(i) for i in np.flatnonzero(tree["axis"] < 0)]
     return [int(i) for i in np.flatnonzero(np.all(tree["children"] < 0, axis=1))]
+
+
+# -- whole searches, and the mistakes' versions of them (grading/mistakes/nn.py) -----------------
+
+
+def _as_rows(queries, width):
+    return np.asarray(queries, dtype=float).reshape(-1, width)
+
+
+def _knn_rows(best_sets, k):
+    indices = np.array([[i for _, i in held] for held in best_sets], dtype=np.int64).reshape(-1, k)
+    distances = np.sqrt(np.array([[s for s, _ in held] for held in best_sets], dtype=float).reshape(-1, k))
+    return indices, distances
+
+
+def _csr_rows(rows):
+    indptr = np.zeros(len(rows) + 1, dtype=np.int64)
+    indptr[1:] = np.cumsum([len(r) for r in rows])
+    pairs = [pair for row in rows for pair in sorted(row)]
+    indices = np.array([i for _, i in pairs], dtype=np.int64)
+    distances = np.sqrt(np.array([s for s, _ in pairs], dtype=float))
+    return indptr, indices, distances
+
+
+def kdtree_search(tree, points, queries, k=None, radius=None, strict=False, far_first=False, prune=True):
+    """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
+
+    The flags give known wrong versions: ``strict`` (the far child only if
+    ``d2 < w2``, radius ``s < r2``), ``far_first``, ``prune=False`` (every leaf).
+    """
+    points = np.asarray(points, dtype=float)
+    queries = _as_rows(queries, points.shape[1])
+    results = []
+    for query in queries:
+        best = _Best(k) if k is not None else None
+        found = []
+
+        def visit(node, query=query, best=best, found=found):
+            if tree["axis"][node] < 0:
+                for position in range(tree["start"][node], tree["stop"][node]):
+                    index = int(tree["order"][position])
+                    s = float(squared_distances(points[index : index + 1], query)[0])
+                    if best is not None:
+                        best.offer(s, index)
+                    elif s < radius**2 or (not strict and s == radius**2):
+                        found.append((s, index))
+                return
+            diff = query[tree["axis"][node]] - tree["split"][node]
+            near, far = (
+                (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+            )
+            if far_first:
+                near, far = far, near
+            visit(near)
+            w2 = best.worst if best is not None else radius**2
+            if not prune or diff * diff < w2 or (not strict and diff * diff == w2):
+                visit(far)
+
+        visit(0)
+        results.append(best.held if best is not None else found)
+    return _knn_rows(results, k) if k is not None else _csr_rows(results)
+
+
+def octree_search(tree, points, queries, k=None, radius=None, contains=True, early=True, own_first=True, box=False):
+    """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
+
+    The flags give known wrong versions: ``contains=False`` (descend into a
+    contained octant), ``early=False`` (no early termination),
+    ``own_first=False`` (children in plain code order), ``box`` (a cube
+    meets the ball if it meets the ball's bounding box: too weak).
+    """
+    xyz = np.asarray(points, dtype=float)[:, :3]
+    queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
+    results = []
+
+    def meets(query, node, w2):
+        c, e = tree["center"][node], tree["extent"][node]
+        if box:
+            return bool(np.all(np.abs(query - c) <= e + math.sqrt(w2)))
+        return _gap2(query, c, e) <= w2
+
+    for query in queries:
+        best = _Best(k) if k is not None else None
+        found = []
+
+        def offer(node, everything=False, query=query, best=best, found=found):
+            for position in range(tree["start"][node], tree["stop"][node]):
+                index = int(tree["order"][position])
+                s = float(squared_distances(xyz[index : index + 1], query)[0])
+                if best is not None:
+                    best.offer(s, index)
+                elif everything or s <= radius**2:
+                    found.append((s, index))
+
+        def radius_visit(node, query=query):
+            c, e = tree["center"][node], tree["extent"][node]
+            if contains and float(np.sum((np.abs(query - c) + e) ** 2)) <= radius**2:
+                offer(node, everything=True)
+            elif _is_leaf(tree, node):
+                offer(node)
+            else:
+                for code in range(8):
+                    child = tree["children"][node, code]
+                    if child >= 0 and meets(query, child, radius**2):
+                        radius_visit(child)
+
+        def knn_visit(node, query=query, best=best):
+            c, e = tree["center"][node], tree["extent"][node]
+            if _is_leaf(tree, node):
+                offer(node)
+            else:
+                own = sum(1 << j for j in range(3) if query[j] > c[j])
+                codes = [own] + [i for i in range(8) if i != own] if own_first else list(range(8))
+                for code in codes:
+                    child = tree["children"][node, code]
+                    if child >= 0 and meets(query, child, best.worst) and knn_visit(child):
+                        return True
+            return early and bool(np.all(np.abs(query - c) + math.sqrt(best.worst) < e))
+
+        if k is not None:
+            knn_visit(0)
+        else:
+            radius_visit(0)
+        results.append(best.held if best is not None else found)
+    return _knn_rows(results, k) if k is not None else _csr_rows(results)
+
+
+def bst_search(keys, left, right, query, k, strict=False):
+    """The contract's BST search (``strict``: the far side only if ``|key - q| < w``, a known mistake)."""
+    best = _Best(k)
+    stack = [(0, False)]
+    while stack:
+        node, near_done = stack.pop()
+        gap = abs(keys[node] - query)
+        go_left = query < keys[node]
+        if not near_done:
+            best.offer(gap, node)
+            stack.append((node, True))
+            near = left[node] if go_left else right[node]
+            if near >= 0:
+                stack.append((near, False))
+            continue
+        far = right[node] if go_left else left[node]
+        if far >= 0 and (gap < best.worst or (not strict and gap == best.worst)):
+            stack.append((far, False))
+    return np.array([i for _, i in best.held], dtype=np.int64), np.array([s for s, _ in best.held], dtype=float)

@@ -66,9 +66,9 @@ class Model:
 
 def model(function):
     """The catalogue entry of ``function``, or None."""
-    from grading.mistakes import downsampling, filters, metrics, normals, pca
+    from grading.mistakes import downsampling, filters, metrics, nn, normals, pca
 
-    for module in (pca, normals, downsampling, filters, metrics):
+    for module in (pca, normals, downsampling, filters, metrics, nn):
         if function in module.MODELS:
             return module.MODELS[function]
     return None

@@ -234,6 +234,21 @@ def test_bst_knn_matches_brute_force(impl):
 
 @pytest.mark.grades("bst_knn")
 @pytest.mark.points(1)
+def test_bst_knn_tie_in_the_far_subtree(impl):
+    # Root 10 (node 0); the second 10 (node 1) goes right; 9 (node 2) goes left. Query 9.5, k = 2: all three
+    # are 0.5 away. The left side holds (0.5, node 2) when the search turns back at the root, with w = 0.5;
+    # |10 - 9.5| = 0.5 <= w, so the right side is searched and node 1 evicts node 2: [0, 1].
+    keys = np.array([10.0, 10.0, 9.0])
+    left, right = bst_of(impl, keys)
+    indices, _ = impl.bst_knn(keys, left, right, 9.5, 2)
+    assert indices.tolist() == [0, 1], (
+        f"expected [0, 1], got {indices.tolist()}: equal keys go right, so a tie at the k-th distance can lie "
+        "on the far side; search it when |keys[j] - query| <= w (inclusive)"
+    )
+
+
+@pytest.mark.grades("bst_knn")
+@pytest.mark.points(1)
 def test_bst_knn_on_a_path_of_sorted_keys(impl):
     keys = np.arange(3000.0) / 2
     left, right = bst_of(impl, keys)
@@ -278,7 +293,9 @@ def test_kdtree_build_hand_worked(impl):
         got = np.asarray(tree.get(key)).tolist()
         assert got == value, f"tree[{key!r}]: expected {value}, got {got}"
     split = np.asarray(tree["split"])
-    assert split[:2].tolist() == [3.0, 2.5] and np.all(np.isnan(split[2:])), f"split: expected [3, 2.5, nan x3], {split}"
+    assert split[:2].tolist() == [3.0, 2.5] and np.all(np.isnan(split[2:])), (
+        f"split: expected [3, 2.5, nan x3], {split}"
+    )
 
 
 @pytest.mark.grades("kdtree_build")

@@ -70,9 +70,7 @@ def test_bst_build_hidden_many_equal_keys(impl):
     keys = np.array([2.0] * 30 + [1.0] * 10 + [3.0] * 10)
     left, right = impl.bst_build(keys)
     expected = trees.bst(keys)
-    assert left.tolist() == expected[0].tolist() and right.tolist() == expected[1].tolist(), (
-        "equal keys go right"
-    )
+    assert left.tolist() == expected[0].tolist() and right.tolist() == expected[1].tolist(), "equal keys go right"
 
 
 @pytest.mark.grades("bst_knn")

@@ -1,0 +1,451 @@
+"""Known mistakes of ``pcl_course/nn.py`` (lecture 2): result set, BST, k-d tree, octree.
+
+The truths are the contract's own searches on the tree they are given
+(``grading/trees.py``), which on a lying tree of the structure tests read
+only the nodes the rule reaches; the mistakes are the same searches with one
+rule changed, or brute force over every point (what a library or a scan of
+the whole cloud gives).
+"""
+
+import math
+
+import numpy as np
+
+from grading import trees
+from grading.mistakes import Mistake, Model, Raised, valid_points
+from pcl_course.validation import check_bst, check_kdtree, check_octree
+
+READS_UNREACHED = (
+    "your search reads points of nodes its rule never reaches (the hidden structure tests plant decoys there): "
+    "a scan of every point, a library's tree, or a search without pruning. Follow the rule: near side first, "
+    "then the far side only if it can still hold a neighbour"
+)
+
+
+def _k_of(k, n):
+    if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or not 1 <= k <= n:
+        raise ValueError("k")
+    return int(k)
+
+
+def _radius_of(radius):
+    if not isinstance(radius, (int, float, np.floating, np.integer)) or not math.isfinite(radius) or radius < 0:
+        raise ValueError("radius")
+    return float(radius)
+
+
+# -- knn_result_set -------------------------------------------------------------------------------
+
+
+def result_set(distances, indices, k, ties="lower", pad=False, sentinel=math.inf):
+    """The contract's result set; ``ties="later"``: an equal distance evicts the worst (a known mistake)."""
+    distances = np.array(distances, dtype=float)
+    indices = np.array(indices)
+    if distances.ndim != 1 or indices.shape != distances.shape or not np.all(np.isfinite(distances)):
+        raise ValueError("candidates")
+    if np.any(distances < 0) or len(set(indices.tolist())) != len(indices) or not isinstance(k, (int, np.integer)):
+        raise ValueError("candidates")
+    if k < 1:
+        raise ValueError("k")
+    held, worst = [], []
+    for d, i in zip(distances.tolist(), indices.tolist()):
+        if len(held) < k:
+            held.append((d, i))
+        elif (d, i) < held[-1] if ties == "lower" else d <= held[-1][0]:
+            held[-1] = (d, i)
+        if ties == "lower":
+            held.sort()
+        else:
+            held.sort(key=lambda pair: pair[0])  # distance only: ties stay in the order they came
+        worst.append(held[-1][0] if len(held) == k else sentinel)
+    out_i = np.array([i for _, i in held], dtype=np.int64)
+    out_d = np.array([d for d, _ in held], dtype=float)
+    if pad and len(held) < k:
+        out_i = np.concatenate([out_i, np.full(k - len(held), -1, dtype=np.int64)])
+        out_d = np.concatenate([out_d, np.full(k - len(held), np.inf)])
+    return out_i, out_d, np.array(worst, dtype=float)
+
+
+KNN_RESULT_SET = Model(
+    truth=result_set,
+    output_dtypes=("int64", "float64", "float64"),
+    mistakes=(
+        Mistake(
+            "ties_to_the_later",
+            "an equal distance must not evict the worst held candidate unless its index is lower: order by "
+            "(distance, index), so that ties go to the lower index",
+            lambda distances, indices, k: result_set(distances, indices, k, ties="later"),
+        ),
+        Mistake(
+            "padded",
+            "return min(k, n) candidates, never padded with -1 or inf when fewer than k were offered",
+            lambda distances, indices, k: result_set(distances, indices, k, pad=True),
+        ),
+        Mistake(
+            "finite_sentinel",
+            "the worst distance is inf while fewer than k are held, not a large finite number: any finite "
+            "sentinel is beaten by a real distance somewhere",
+            lambda distances, indices, k: result_set(distances, indices, k, sentinel=1e10),
+        ),
+    ),
+)
+
+
+# -- BST ------------------------------------------------------------------------------------------
+
+
+def _keys(keys):
+    keys = np.array(keys, dtype=float)
+    if keys.ndim != 1 or not np.all(np.isfinite(keys)):
+        raise ValueError("keys")
+    return keys
+
+
+def bst_build(keys, equal="right"):
+    keys = _keys(keys)
+    if equal == "right":
+        return trees.bst(keys)
+    return trees.bst(-keys)  # equal keys left: the mirror image of inserting the negated keys
+
+
+def _recursive_build(keys):
+    keys = _keys(keys)
+    left, right = trees.bst(keys)
+    depth, frontier = 0, [0] if len(keys) else []
+    while frontier:
+        frontier = [c for n in frontier for c in (left[n], right[n]) if c >= 0]
+        depth += 1
+    return Raised("RecursionError") if depth > 900 else None
+
+
+BST_BUILD = Model(
+    truth=bst_build,
+    output_dtypes=("int64", "int64"),
+    mistakes=(
+        Mistake(
+            "equal_keys_left",
+            "a key equal to a node's key goes RIGHT (left only if key < keys[j])",
+            lambda keys: tuple(np.where(a >= 0, a, -1) for a in reversed(bst_build(keys, equal="left"))),
+        ),
+        Mistake(
+            "recursive",
+            "sorted keys make a path thousands of levels deep: insert with a loop, not one recursive call per "
+            "level (Python's recursion limit is 1,000)",
+            _recursive_build,
+        ),
+    ),
+)
+
+
+def _bst_case(keys, left, right, query, k):
+    keys = _keys(keys)
+    left, right = check_bst(left, right, len(keys))  # a loop in the links would never end
+    if not isinstance(query, (int, float, np.floating, np.integer)) or not math.isfinite(query):
+        raise ValueError("query")
+    return keys, left, right, float(query), _k_of(k, len(keys))
+
+
+def bst_knn(keys, left, right, query, k, strict=False):
+    return trees.bst_search(*_bst_case(keys, left, right, query, k), strict=strict)
+
+
+def bst_brute(keys, left, right, query, k):
+    keys, left, right, query, k = _bst_case(keys, left, right, query, k)
+    rank = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
+    return rank.astype(np.int64), np.abs(keys[rank] - query)
+
+
+BST_KNN = Model(
+    truth=bst_knn,
+    output_dtypes=("int64", "float64"),
+    mistakes=(
+        Mistake("reads_unreached", READS_UNREACHED, bst_brute),
+        Mistake(
+            "strict_prune",
+            "go to the far side when |keys[j] - query| <= w (inclusive): with a strict <, a key at exactly the "
+            "k-th distance with a lower index is missed",
+            lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, strict=True),
+        ),
+    ),
+)
+
+
+# -- k-d tree -------------------------------------------------------------------------------------
+
+
+def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="depth"):
+    points = valid_points(points)
+    if not isinstance(leaf_size, (int, np.integer)) or leaf_size < 1:
+        raise ValueError("leaf_size")
+    if median == "ceil" and split == "mean" and axis_rule == "depth":
+        return trees.kdtree(points, int(leaf_size))
+    n, dim = points.shape
+    nodes, order = [], []
+
+    def grow(indices, depth):
+        node = len(nodes)
+        nodes.append([len(order), None, -1, math.nan, -1, -1])
+        if len(indices) <= leaf_size:
+            order.extend(sorted(indices))
+        else:
+            if axis_rule == "spread":
+                axis = int(np.argmax(np.ptp(points[indices], axis=0)))
+            else:
+                axis = depth % dim
+            ranked = sorted(indices, key=lambda i: (points[i, axis], i))
+            m = (len(ranked) + 1) // 2 if median == "ceil" else len(ranked) // 2
+            nodes[node][2] = axis
+            nodes[node][3] = (
+                (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2
+                if split == "mean"
+                else points[ranked[m], axis]
+            )
+            nodes[node][4] = grow(ranked[:m], depth + 1)
+            nodes[node][5] = grow(ranked[m:], depth + 1)
+        nodes[node][1] = len(order)
+        return node
+
+    grow(list(range(n)), 0)
+    table = list(zip(*nodes))
+    keys = ("start", "stop", "axis", "split", "left", "right")
+    tree = {"order": np.array(order, dtype=np.int64)}
+    tree.update(
+        {key: np.array(column, dtype=float if key == "split" else np.int64) for key, column in zip(keys, table)}
+    )
+    return tree
+
+
+KDTREE_BUILD = Model(
+    truth=kdtree_build,
+    mistakes=(
+        Mistake(
+            "floor_median",
+            "the left child takes m = ceil(n / 2) points, (n + 1) // 2, not n // 2",
+            lambda points, leaf_size=16: kdtree_build(points, leaf_size, median="floor"),
+        ),
+        Mistake(
+            "split_at_a_point",
+            "split = (c[m - 1] + c[m]) / 2, halfway between the two middle coordinates, not a point's coordinate",
+            lambda points, leaf_size=16: kdtree_build(points, leaf_size, split="point"),
+        ),
+        Mistake(
+            "axis_by_spread",
+            "the contract's axis is depth % D (round robin), not the axis of largest spread",
+            lambda points, leaf_size=16: kdtree_build(points, leaf_size, axis_rule="spread"),
+        ),
+    ),
+)
+
+
+def _kd_case(tree, points, queries):
+    points = valid_points(points, min_columns=1)
+    queries = valid_points(queries, min_columns=points.shape[1], max_columns=points.shape[1])
+    check_kdtree(tree, len(points), points.shape[1])
+    return tree, points, queries
+
+
+def kdtree_knn(tree, points, queries, k, **changes):
+    tree, points, queries = _kd_case(tree, points, queries)
+    return trees.kdtree_search(tree, points, queries, k=_k_of(k, len(points)), **changes)
+
+
+def kdtree_radius(tree, points, queries, radius, **changes):
+    tree, points, queries = _kd_case(tree, points, queries)
+    return trees.kdtree_search(tree, points, queries, radius=_radius_of(radius), **changes)
+
+
+KDTREE_KNN = Model(
+    truth=kdtree_knn,
+    output_dtypes=("int64", "float64"),
+    mistakes=(
+        Mistake(
+            "reads_unreached",
+            READS_UNREACHED,
+            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, prune=False),
+        ),
+        Mistake(
+            "far_side_first",
+            "search the child on the query's side first (q[axis] <= split: left): the far side first reads "
+            "leaves the rule never reaches",
+            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, far_first=True),
+        ),
+        Mistake(
+            "strict_prune",
+            "visit the far child when (q[axis] - split) ** 2 <= w2, inclusive: equal coordinates lie on both "
+            "sides of a split, so a tie at the k-th distance can be there",
+            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, strict=True),
+        ),
+    ),
+)
+
+KDTREE_RADIUS = Model(
+    truth=kdtree_radius,
+    output_dtypes=("int64", "int64", "float64"),
+    mistakes=(
+        Mistake(
+            "reads_unreached",
+            READS_UNREACHED,
+            lambda tree, points, queries, radius: kdtree_radius(tree, points, queries, radius, prune=False),
+        ),
+        Mistake(
+            "strict_radius",
+            "the radius is inclusive: keep points with squared distance <= radius ** 2, and visit the far child "
+            "when (q[axis] - split) ** 2 <= radius ** 2",
+            lambda tree, points, queries, radius: kdtree_radius(tree, points, queries, radius, strict=True),
+        ),
+    ),
+)
+
+
+# -- octree ---------------------------------------------------------------------------------------
+
+
+def octree_build(points, leaf_size=8, min_extent=1e-3, root="bbox", plane="lower"):
+    points = valid_points(points, min_columns=3)
+    if not isinstance(leaf_size, (int, np.integer)) or leaf_size < 1:
+        raise ValueError("leaf_size")
+    if not isinstance(min_extent, (int, float, np.floating)) or not math.isfinite(min_extent) or min_extent <= 0:
+        raise ValueError("min_extent")
+    if root == "bbox" and plane == "lower":
+        return trees.octree(points, int(leaf_size), float(min_extent))
+    xyz = points[:, :3]
+    if len(xyz) == 0:
+        return None
+    lower, upper = xyz.min(axis=0), xyz.max(axis=0)
+    extent = float(np.max((upper - lower) / 2))
+    if root == "mean":  # the bounding box's half side, around the mean
+        return _grow_from(xyz, int(leaf_size), float(min_extent), xyz.mean(axis=0), extent)
+    return _grow_from(xyz, int(leaf_size), float(min_extent), (lower + upper) / 2, extent, upper_on_plane=True)
+
+
+def _grow_from(xyz, leaf_size, min_extent, root_center, root_extent, upper_on_plane=False):
+    nodes, order = [], []
+
+    def grow(indices, center, extent):
+        node = len(nodes)
+        nodes.append([len(order), None, center, extent, [-1] * 8])
+        if len(indices) <= leaf_size or extent <= min_extent:
+            order.extend(sorted(indices))
+        else:
+            groups = {}
+            for i in indices:
+                above = (xyz[i] >= center) if upper_on_plane else (xyz[i] > center)
+                groups.setdefault(int(sum(1 << j for j in range(3) if above[j])), []).append(i)
+            for code in sorted(groups):
+                signs = np.array([1.0 if code >> j & 1 else -1.0 for j in range(3)])
+                nodes[node][4][code] = grow(groups[code], center + signs * extent / 2, extent / 2)
+        nodes[node][1] = len(order)
+        return node
+
+    grow(list(range(len(xyz))), np.asarray(root_center, dtype=float), float(root_extent))
+    return {
+        "order": np.array(order, dtype=np.int64),
+        "start": np.array([n[0] for n in nodes], dtype=np.int64),
+        "stop": np.array([n[1] for n in nodes], dtype=np.int64),
+        "center": np.array([n[2] for n in nodes], dtype=float).reshape(-1, 3),
+        "extent": np.array([n[3] for n in nodes], dtype=float),
+        "children": np.array([n[4] for n in nodes], dtype=np.int64).reshape(-1, 8),
+    }
+
+
+OCTREE_BUILD = Model(
+    truth=octree_build,
+    mistakes=(
+        Mistake(
+            "mean_root",
+            "centre the root cube at the bounding box's centre, (min + max) / 2, with extent max((max - min) / 2): "
+            "a cube around the mean leaves points of a skewed cloud outside it",
+            lambda points, leaf_size=8, min_extent=1e-3: octree_build(points, leaf_size, min_extent, root="mean"),
+        ),
+        Mistake(
+            "upper_on_plane",
+            "a point on a centre plane goes to the LOWER child: the code uses strict x > cx (and y, z)",
+            lambda points, leaf_size=8, min_extent=1e-3: octree_build(points, leaf_size, min_extent, plane="upper"),
+        ),
+    ),
+)
+
+
+def _octree_case(tree, points, queries):
+    points = valid_points(points, min_columns=3)
+    queries = valid_points(queries, min_columns=points.shape[1], max_columns=points.shape[1])
+    check_octree(tree, len(points))
+    return tree, points, queries
+
+
+def octree_radius(tree, points, queries, radius, **changes):
+    tree, points, queries = _octree_case(tree, points, queries)
+    return trees.octree_search(tree, points, queries, radius=_radius_of(radius), **changes)
+
+
+def octree_knn(tree, points, queries, k, **changes):
+    tree, points, queries = _octree_case(tree, points, queries)
+    return trees.octree_search(tree, points, queries, k=_k_of(k, len(points)), **changes)
+
+
+def _brute_csr(tree, points, queries, radius):
+    tree, points, queries = _octree_case(tree, points, queries)
+    rows = [trees.brute_radius(points[:, :3], q[:3], _radius_of(radius)) for q in queries]
+    indptr = np.concatenate([[0], np.cumsum([len(r[0]) for r in rows])]).astype(np.int64)
+    return (
+        indptr,
+        np.concatenate([r[0] for r in rows] or [np.empty(0, np.int64)]),
+        np.concatenate([r[1] for r in rows] or [np.empty(0)]),
+    )
+
+
+OCTREE_RADIUS = Model(
+    truth=octree_radius,
+    output_dtypes=("int64", "int64", "float64"),
+    mistakes=(
+        Mistake("reads_unreached", READS_UNREACHED, _brute_csr),
+        Mistake(
+            "box_overlap",
+            "a child's cube meets the ball iff sum_j max(|q_j - c_j| - e, 0) ** 2 <= r ** 2 (the distance to the "
+            "cube); testing each axis alone (the ball's bounding box) is too weak and reads octants the rule skips",
+            lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, box=True),
+        ),
+        Mistake(
+            "no_contains",
+            "when the ball contains an octant's cube, sum_j (|q_j - c_j| + e) ** 2 <= r ** 2, report all its "
+            "points at once without descending (the contains shortcut)",
+            lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, contains=False),
+        ),
+    ),
+)
+
+OCTREE_KNN = Model(
+    truth=octree_knn,
+    output_dtypes=("int64", "float64"),
+    mistakes=(
+        Mistake(
+            "reads_unreached",
+            READS_UNREACHED,
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, early=False, box=True),
+        ),
+        Mistake(
+            "no_early_termination",
+            "after an octant is processed, end the query if the ball of the k-th distance lies strictly inside "
+            "its cube (|q_j - c_j| + w < e for every j): early termination",
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, early=False),
+        ),
+        Mistake(
+            "code_order_only",
+            "visit the child whose code the query has first, then the others in code order",
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, own_first=False),
+        ),
+    ),
+)
+
+
+MODELS = {
+    "knn_result_set": KNN_RESULT_SET,
+    "bst_build": BST_BUILD,
+    "bst_knn": BST_KNN,
+    "kdtree_build": KDTREE_BUILD,
+    "kdtree_knn": KDTREE_KNN,
+    "kdtree_radius": KDTREE_RADIUS,
+    "octree_build": OCTREE_BUILD,
+    "octree_radius": OCTREE_RADIUS,
+    "octree_knn": OCTREE_KNN,
+}
