@@ -170,6 +170,10 @@ class _Best:
     def offer(self, s, index):
         self.held = sorted([*self.held, (s, index)])[: self.k]
 
+    def offer_all(self, squared, indices):
+        """Offer many candidates at once (the same outcome as one at a time)."""
+        self.held = sorted([*self.held, *zip(squared.tolist(), indices.tolist())])[: self.k]
+
     @property
     def worst(self):
         return self.held[-1][0] if len(self.held) == self.k else math.inf
@@ -414,6 +418,12 @@ def kdtree_search(tree, points, queries, k=None, radius=None, strict=False, far_
     """
     points = np.asarray(points, dtype=float)
     queries = _as_rows(queries, points.shape[1])
+    if not prune:  # every leaf is read: the rows of brute force over every point
+        if k is not None:
+            rows = [brute_knn(points, query, k) for query in queries]
+            return np.array([r[0] for r in rows]).reshape(-1, k), np.array([r[1] for r in rows]).reshape(-1, k)
+        rows = [brute_radius(points, query, radius) for query in queries]
+        return _csr_rows([list(zip((r[1] ** 2).tolist(), r[0].tolist())) for r in rows])
     results = []
     for query in queries:
         best = _Best(k) if k is not None else None
@@ -421,13 +431,13 @@ def kdtree_search(tree, points, queries, k=None, radius=None, strict=False, far_
 
         def visit(node, query=query, best=best, found=found):
             if tree["axis"][node] < 0:
-                for position in range(tree["start"][node], tree["stop"][node]):
-                    index = int(tree["order"][position])
-                    s = float(squared_distances(points[index : index + 1], query)[0])
-                    if best is not None:
-                        best.offer(s, index)
-                    elif s < radius**2 or (not strict and s == radius**2):
-                        found.append((s, index))
+                indices = tree["order"][tree["start"][node] : tree["stop"][node]]
+                s = squared_distances(points[indices], query)
+                if best is not None:
+                    best.offer_all(s, indices)
+                else:
+                    keep = (s < radius**2) | ((s == radius**2) & (not strict))
+                    found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
                 return
             diff = query[tree["axis"][node]] - tree["split"][node]
             near, far = (
@@ -468,13 +478,13 @@ def octree_search(tree, points, queries, k=None, radius=None, contains=True, ear
         found = []
 
         def offer(node, everything=False, query=query, best=best, found=found):
-            for position in range(tree["start"][node], tree["stop"][node]):
-                index = int(tree["order"][position])
-                s = float(squared_distances(xyz[index : index + 1], query)[0])
-                if best is not None:
-                    best.offer(s, index)
-                elif everything or s <= radius**2:
-                    found.append((s, index))
+            indices = tree["order"][tree["start"][node] : tree["stop"][node]]
+            s = squared_distances(xyz[indices], query)
+            if best is not None:
+                best.offer_all(s, indices)
+            else:
+                keep = np.ones(len(s), dtype=bool) if everything else s <= radius**2
+                found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
 
         def radius_visit(node, query=query):
             c, e = tree["center"][node], tree["extent"][node]
