@@ -134,8 +134,8 @@ def bst_build(keys):
 
     Notes
     -----
-    Sorted keys make a path of depth N - 1: the build must handle a few
-    thousand of them, so it cannot recurse once per level (Python's
+    Sorted keys make a path of depth N - 1: the build must handle more
+    than a thousand of them, so it cannot recurse once per level (Python's
     recursion limit is 1,000). The same holds for :func:`bst_knn`.
 
     Examples

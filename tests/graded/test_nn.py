@@ -188,9 +188,9 @@ def test_bst_build_inserts_in_order_with_duplicates(impl):
 @pytest.mark.grades("bst_build")
 @pytest.mark.points(2)
 def test_bst_build_of_sorted_keys_is_a_path(impl):
-    keys = np.arange(3000.0)  # depth 2999: beyond Python's recursion limit
+    keys = np.arange(1500.0)  # depth 1499: beyond Python's recursion limit
     left, right = impl.bst_build(keys)
-    assert np.all(left == -1) and right.tolist() == [*range(1, 3000), -1], (
+    assert np.all(left == -1) and right.tolist() == [*range(1, 1500), -1], (
         "sorted keys make a path of right children; build it with a loop, not one recursive call per level"
     )
 
@@ -250,10 +250,10 @@ def test_bst_knn_tie_in_the_far_subtree(impl):
 @pytest.mark.grades("bst_knn")
 @pytest.mark.points(1)
 def test_bst_knn_on_a_path_of_sorted_keys(impl):
-    keys = np.arange(3000.0) / 2
+    keys = np.arange(1500.0) / 2
     left, right = bst_of(impl, keys)
-    indices, distances = impl.bst_knn(keys, left, right, 1400.3, 3)
-    assert indices.tolist() == [2801, 2800, 2802], "a path of depth 2999: search it with a loop or an explicit stack"
+    indices, distances = impl.bst_knn(keys, left, right, 700.3, 3)
+    assert indices.tolist() == [1401, 1400, 1402], "a path of depth 1499: search it with a loop or an explicit stack"
 
 
 @pytest.mark.grades("bst_knn")

@@ -8,7 +8,9 @@ then throws the answer away:
 ``echo``    the first argument handed back in place of the answer;
 ``random``  right-shape, right-dtype random values (seeded).
 
-``tests/project/test_grading.py`` grades each one with its function's tests:
+``tests/project/test_grading.py`` grades each one with its function's tests
+(for a module whose tests never call another of its functions, all of its
+functions at once, with :func:`module_source`):
 it must lose points on every test not marked ``interface`` (the tests of
 shapes, dtypes, errors and in-place changes, which a degenerate answer may
 pass).
@@ -71,3 +73,17 @@ def source(function, module, kind):
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     return TEMPLATE.format(function=function, module=module, kind=kind)
+
+
+def module_source(functions, module, kind):
+    """The text of the degenerate ``module`` whose every function of ``functions`` answers ``kind``."""
+    text = source(functions[0], module, kind)
+    for function in functions[1:]:
+        text += (
+            f"\n\nfrom solutions.{module} import {function} as _reference_{function}  # noqa: E402\n\n\n"
+            f"def {function}(*args, **kwargs):\n"
+            f"    answer = _reference_{function}(*args, **kwargs)\n"
+            "    first = args[0] if args else next(iter(kwargs.values()))\n"
+            "    return _degrade(answer, first)\n"
+        )
+    return text

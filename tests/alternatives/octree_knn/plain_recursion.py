@@ -23,8 +23,9 @@ def _search(tree, xyz, query, k):
         nonlocal held
         children = tree["children"][node]
         if np.all(children < 0):
-            for index in tree["order"][tree["start"][node] : tree["stop"][node]]:
-                held = sorted([*held, (float(np.sum((xyz[index] - query) ** 2)), int(index))])[:k]
+            indices = tree["order"][tree["start"][node] : tree["stop"][node]]
+            squared = ((xyz[indices] - query) ** 2).sum(axis=1)
+            held = sorted([*held, *zip(squared.tolist(), indices.tolist())])[:k]
             return inside(node)
         own = int(
             (query[0] > tree["center"][node][0])
