@@ -25,35 +25,51 @@ def _fail(message, rule):
 
 
 def check_bst(left, right, keys):
-    """``(left, right)`` is the BST of ``keys`` inserted in order, equal keys to the right."""
+    """``(left, right)`` is the BST of ``keys`` inserted in order, equal keys to the right.
+
+    Checked by two properties that together make that tree unique (it is a
+    treap whose priority is the insertion index): every node's parent was
+    inserted before it, and the in-order traversal lists the keys sorted,
+    equal keys in insertion order.
+    """
     n = len(keys)
     check_array(left, "left", shape=(n,), dtype="int64")
     check_array(right, "right", shape=(n,), dtype="int64")
-    parent_of = {}
+    has_parent = np.zeros(n, dtype=bool)
     for j in range(n):
         for side, links in (("left", left), ("right", right)):
             child = int(links[j])
-            if child != -1 and not 0 < child < n:
-                _fail(f"{side}[{j}] = {child} is neither -1 nor a node id 1..{n - 1}", "a link is not a node id")
-            if child > 0:
-                if child in parent_of:
-                    _fail(f"node {child} is the child of two nodes", "a node has two parents")
-                parent_of[child] = (j, side)
-    for i in range(1, n):
-        node = 0
-        while True:
-            side = "left" if keys[i] < keys[node] else "right"
-            child = int((left if side == "left" else right)[node])
-            if child == i:
-                break
-            if child < 0 or child > i:
-                hint = " (equal keys go right)" if keys[i] == keys[node] else ""
+            if child == -1:
+                continue
+            if not j < child < n:
                 _fail(
-                    f"key {i} ({keys[i]:g}) is inserted {side} of node {node} ({keys[node]:g}){hint}, "
-                    f"but {side}[{node}] = {child}",
-                    "a key is not where inserting the keys in order puts it",
+                    f"{side}[{j}] = {child}: a child is inserted after its parent (a larger id below {n}), or -1",
+                    "a link is not a later node",
                 )
-            node = child
+            if has_parent[child]:
+                _fail(f"node {child} is the child of two nodes", "a node has two parents")
+            has_parent[child] = True
+    if n and not has_parent[1:].all():
+        _fail(f"node {int(np.flatnonzero(~has_parent[1:])[0]) + 1} hangs nowhere: every key is inserted", "lost nodes")
+    visited, stack, node = [], [], 0 if n else -1
+    while stack or node != -1:
+        while node != -1:
+            stack.append(node)
+            node = int(left[node])
+        node = stack.pop()
+        visited.append(node)
+        node = int(right[node])
+    expected = np.lexsort((np.arange(n), keys))
+    wrong = np.flatnonzero(np.asarray(visited) != expected)
+    if len(wrong):
+        at = int(wrong[0])
+        a = visited[at]
+        _fail(
+            f"the in-order traversal must list the keys sorted, equal keys in insertion order; at position {at} "
+            f"it gives node {a} (key {keys[a]:g}), the sorted order gives node {expected[at]} "
+            f"(key {keys[expected[at]]:g}) (a key smaller than a node's goes left; an equal or larger one, right)",
+            "a key is not where inserting the keys in order puts it",
+        )
 
 
 def _check_keys(tree, keys, n_points):
