@@ -271,9 +271,7 @@ def check_csr(result, expected_rows, what="radius search"):
             if set(got.tolist()) == set(rows.tolist()):
                 hint = "the right neighbours in another order: sort each row by (squared distance, index)"
             elif len(got) < len(rows):
-                hint = (
-                    "neighbours are missing: the test is inclusive (<= radius ** 2); prune only what cannot hold one"
-                )
+                hint = "neighbours are missing: the test is inclusive (<= radius ** 2); prune only what cannot hold one"
             else:
                 hint = "extra points: keep only those with squared distance <= radius ** 2"
             _fail(
