@@ -38,6 +38,9 @@ __all__ = [
     "outlier_filters",
     "filtered_images",
     "box_slices",
+    "kdtree_leaf_cells",
+    "bst_drawing",
+    "kdtree_partitions",
 ]
 
 
@@ -849,4 +852,122 @@ def box_slices(clouds, slab, outline):
         ax.set(title=label, aspect="equal", xlim=(-0.6 * width, 0.6 * width), ylim=(-0.7 * height, 0.7 * height),
                xlabel="x")  # fmt: skip
     axes[0].set_ylabel("z")
+    plt.show()
+
+
+def kdtree_leaf_cells(tree, lower, upper):
+    """The cell (a box) of every leaf of a k-d tree, clipped to ``[lower, upper]``.
+
+    Parameters
+    ----------
+    tree : dict
+        A k-d tree as ``pcl_course.nn.kdtree_build`` returns it.
+    lower, upper : array_like of shape (D,)
+        The box the root's cell is clipped to (a cell is unbounded otherwise).
+
+    Returns
+    -------
+    dict of int to (ndarray, ndarray)
+        Leaf node id -> (lower corner, upper corner) of its cell.
+    """
+    cells, stack = {}, [(0, np.asarray(lower, dtype=float), np.asarray(upper, dtype=float))]
+    while stack:
+        node, low, high = stack.pop()
+        if tree["axis"][node] < 0:
+            cells[node] = (low, high)
+            continue
+        axis, split = tree["axis"][node], tree["split"][node]
+        left_high, right_low = high.copy(), low.copy()
+        left_high[axis], right_low[axis] = split, split
+        stack += [(tree["left"][node], low, left_high), (tree["right"][node], right_low, high)]
+    return cells
+
+
+def _box_distance(query, low, high):
+    return float(np.sqrt(np.sum((np.maximum(low - query, 0) + np.maximum(query - high, 0)) ** 2)))
+
+
+def bst_drawing(keys, left, right, query, neighbours, figsize=(9, 3.6)):
+    """A binary search tree drawn with each node at (in-order rank, depth).
+
+    The query's k nearest keys are marked, and every node whose key lies
+    within the k-th distance of the query is outlined: a search must read
+    those, whatever its order.
+
+    Parameters
+    ----------
+    keys : array_like of shape (N,)
+    left, right : array_like of int, shape (N,)
+        As ``pcl_course.nn.bst_build`` returns them.
+    query : float
+    neighbours : array_like of int
+        The k nearest nodes (ids).
+    """
+    import matplotlib.pyplot as plt
+
+    keys = np.asarray(keys, dtype=float)
+    n = len(keys)
+    depth = np.zeros(n, dtype=int)
+    for node in range(n):  # parents come before their children
+        for child in (left[node], right[node]):
+            if child >= 0:
+                depth[child] = depth[node] + 1
+    rank = np.empty(n, dtype=int)
+    rank[np.lexsort((np.arange(n), keys))] = np.arange(n)
+    w = np.max(np.abs(keys[np.asarray(neighbours)] - query))
+    fig, ax = plt.subplots(figsize=figsize)
+    for node in range(n):
+        for child in (left[node], right[node]):
+            if child >= 0:
+                ax.plot([rank[node], rank[child]], [-depth[node], -depth[child]], c="0.7", lw=1, zorder=1)
+    must = np.abs(keys - query) <= w
+    ax.scatter(rank[~must], -depth[~must], s=120, c="white", edgecolors="0.5", zorder=2, label="farther than w")
+    ax.scatter(rank[must], -depth[must], s=120, c="white", edgecolors="tab:orange", lw=2, zorder=2,
+               label="within w of the query")  # fmt: skip
+    ax.scatter(rank[neighbours], -depth[neighbours], s=60, c="tab:orange", zorder=3, label="the k nearest")
+    for node in range(n):
+        ax.annotate(f"{keys[node]:g}", (rank[node], -depth[node]), xytext=(0, 9), textcoords="offset points",
+                    ha="center", fontsize=8)  # fmt: skip
+    position = np.interp(query, np.sort(keys), np.arange(n))
+    ax.axvline(position, ls=":", c="tab:blue", label=f"query {query:g}")
+    ax.set(xlabel="in-order rank (sorted keys)", ylabel="depth", yticks=-np.arange(depth.max() + 1),
+           yticklabels=np.arange(depth.max() + 1))  # fmt: skip
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    plt.show()
+
+
+def kdtree_partitions(panels, query, k, figsize=(11, 5.2)):
+    """2-D k-d tree partitions side by side, with one query's k-nearest ball.
+
+    Leaves whose cell meets the ball (every exact search must read them) are
+    shaded; the others are the leaves a good search prunes.
+
+    Parameters
+    ----------
+    panels : dict of str to (points, tree)
+        Title -> a 2-D cloud (N, 2) and a k-d tree of it.
+    query : array_like of shape (2,)
+    k : int
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Rectangle
+
+    fig, axes = plt.subplots(1, len(panels), figsize=figsize, squeeze=False)
+    query = np.asarray(query, dtype=float)
+    for ax, (title, (points, tree)) in zip(axes[0], panels.items()):
+        lower, upper = points.min(axis=0), points.max(axis=0)
+        radius = np.sort(np.linalg.norm(points - query, axis=1))[k - 1]
+        cells = kdtree_leaf_cells(tree, lower, upper)
+        met = 0
+        for low, high in cells.values():
+            meets = _box_distance(query, low, high) <= radius
+            met += meets
+            ax.add_patch(Rectangle(low, *(high - low), fill=meets, fc="tab:orange", alpha=0.25 if meets else 1,
+                                   ec="0.4", lw=0.6))  # fmt: skip
+        ax.scatter(points[:, 0], points[:, 1], s=2, c="k")
+        ax.add_patch(Circle(query, radius, fill=False, ec="tab:blue", lw=1.5))
+        ax.plot(*query, marker="*", c="tab:blue", ms=10)
+        ax.set(title=f"{title}: {met} of {len(cells)} leaves meet the ball", aspect="equal")
+        ax.set_xlim(lower[0], upper[0])
+        ax.set_ylim(lower[1], upper[1])
     plt.show()
