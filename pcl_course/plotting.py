@@ -41,6 +41,8 @@ __all__ = [
     "kdtree_leaf_cells",
     "bst_drawing",
     "kdtree_partitions",
+    "octant_tests",
+    "root_squares",
 ]
 
 
@@ -970,4 +972,64 @@ def kdtree_partitions(panels, query, k, figsize=(11, 5.2)):
         ax.set(title=f"{title}: {met} of {len(cells)} leaves meet the ball", aspect="equal")
         ax.set_xlim(lower[0], upper[0])
         ax.set_ylim(lower[1], upper[1])
+    plt.show()
+
+
+def octant_tests(center, extent, balls, verdicts, figsize=(6.5, 5.2)):
+    """One square cell (the 2-D picture of an octant) and query balls, each labelled with its verdicts.
+
+    Parameters
+    ----------
+    center : array_like of shape (2,)
+    extent : float
+        Half the side of the square.
+    balls : list of (array_like of shape (2,), float)
+        Query centres and radii.
+    verdicts : list of str
+        One label per ball (which of overlaps / contains / inside hold).
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Circle, Rectangle
+
+    center = np.asarray(center, dtype=float)
+    fig, ax = plt.subplots(figsize=figsize)
+    ax.add_patch(Rectangle(center - extent, 2 * extent, 2 * extent, fill=True, fc="0.92", ec="k", lw=1.5))
+    colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for (query, radius), verdict, color in zip(balls, verdicts, colors):
+        ax.add_patch(Circle(query, radius, fill=False, ec=color, lw=2, label=verdict))
+        ax.plot(*query, marker="o", c=color, ms=4)
+    reach = max(np.max(np.abs(np.asarray(q) - center)) + r for q, r in balls)
+    ax.set(xlim=(center[0] - reach, center[0] + reach), ylim=(center[1] - reach, center[1] + reach), aspect="equal")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    plt.show()
+
+
+def root_squares(points, panels, figsize=(10, 4.6)):
+    """A 2-D cloud with candidate root squares; the points each square leaves out in red.
+
+    Parameters
+    ----------
+    points : ndarray of shape (N, 2)
+    panels : dict of str to (array_like of shape (2,), float)
+        Title -> the square's centre and half side.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    fig, axes = plt.subplots(1, len(panels), figsize=figsize, squeeze=False)
+    lower, upper = points.min(axis=0), points.max(axis=0)
+    for center, extent in panels.values():
+        lower = np.minimum(lower, np.asarray(center) - extent)
+        upper = np.maximum(upper, np.asarray(center) + extent)
+    pad = 0.15 * np.max(upper - lower)
+    for ax, (title, (center, extent)) in zip(axes[0], panels.items()):
+        center = np.asarray(center, dtype=float)
+        outside = np.any(np.abs(points - center) > extent, axis=1)
+        ax.scatter(*points[~outside].T, s=3, c="0.3")
+        ax.scatter(*points[outside].T, s=12, c="tab:red", label=f"outside the root: {outside.sum()}")
+        ax.add_patch(Rectangle(center - extent, 2 * extent, 2 * extent, fill=False, ec="tab:blue", lw=1.5))
+        ax.plot(*center, marker="+", c="tab:blue", ms=12)
+        ax.set(title=title, aspect="equal", xlim=(lower[0] - pad, upper[0] + pad),
+               ylim=(lower[1] - pad, upper[1] + pad))  # fmt: skip
+        ax.legend(loc="lower right")
     plt.show()
