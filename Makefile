@@ -67,6 +67,7 @@ gradescope: setup
 # implementations use both cores), no per-test timeout. The summary, committed,
 # feeds the book's appendix. BENCH_ARGS passes options, e.g.
 #   make bench BENCH_ARGS="--bench-sizes=100000 -k normals"
+# BENCH_MERGE=1 keeps the committed results of the cases a partial run did not measure.
 BENCH_ARGS ?=
 BENCH_OUT  ?= benchmarks/results
 bench: setup
@@ -74,7 +75,7 @@ bench: setup
 	$(BIN)/python -m pytest benchmarks -p no:xdist -p no:dash -p no:cacheprovider -o addopts= -o timeout=0 \
 	    -q --benchmark-json=_build/bench/raw.json --benchmark-save-data --benchmark-columns=median,iqr,rounds \
 	    --benchmark-sort=name $(BENCH_ARGS)
-	$(BIN)/python -m benchmarks.report _build/bench/raw.json $(BENCH_OUT)
+	$(BIN)/python -m benchmarks.report _build/bench/raw.json $(BENCH_OUT) $(if $(BENCH_MERGE),--merge)
 
 # Re-pin the lock, requirements/course.txt, from requirements/course.in, then
 # its two subsets, grading.txt and student.txt, with the lock as constraints.

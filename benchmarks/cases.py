@@ -233,6 +233,114 @@ def _chamfer_case(n):
     return Case("chamfer_distance", "", "shape", n, make)
 
 
+# -- lecture 2: nearest neighbours ---------------------------------------------------------------
+
+
+def _nn_peers(xyz):
+    """The libraries' trees of ``xyz``, built outside the timed calls of a search."""
+    from pykdtree.kdtree import KDTree as PyKDTree
+    from scipy.spatial import cKDTree
+    from sklearn.neighbors import KDTree
+
+    index = o3d.core.nns.NearestNeighborSearch(o3d.core.Tensor(np.array(xyz)))
+    return {"scipy-ckdtree": cKDTree(xyz), "sklearn-kdtree": KDTree(xyz), "pykdtree": PyKDTree(xyz), "open3d": index}
+
+
+def _kdtree_build_case(dataset, n):
+    def make():
+        from pykdtree.kdtree import KDTree as PyKDTree
+        from scipy.spatial import cKDTree
+        from sklearn.neighbors import KDTree
+
+        from solutions.nn import kdtree_build
+
+        xyz = cloud(dataset, n)
+        return {
+            "reference": lambda: kdtree_build(xyz, 16),
+            "scipy-ckdtree": lambda: cKDTree(xyz),
+            "sklearn-kdtree": lambda: KDTree(xyz),
+            "pykdtree": lambda: PyKDTree(xyz),
+            "open3d": lambda: o3d.core.nns.NearestNeighborSearch(o3d.core.Tensor(np.array(xyz))).knn_index(),
+        }
+
+    return Case("kdtree_build", "", dataset, n, make, {"leaf_size": 16}, ("scipy-ckdtree", 1.0))
+
+
+def _kdtree_knn_case(dataset, n, k):
+    def make():
+        from solutions.nn import kdtree_build, kdtree_knn
+
+        xyz = cloud(dataset, n)
+        tree = kdtree_build(xyz, 16)
+        peers = _nn_peers(xyz)
+        peers["open3d"].knn_index()
+        return {
+            "reference": lambda: kdtree_knn(tree, xyz, xyz, k),
+            "scipy-ckdtree": lambda: peers["scipy-ckdtree"].query(xyz, k, workers=-1),
+            "sklearn-kdtree": lambda: peers["sklearn-kdtree"].query(xyz, k),
+            "pykdtree": lambda: peers["pykdtree"].query(xyz, k),
+            "open3d": lambda: peers["open3d"].knn_search(o3d.core.Tensor(np.array(xyz)), k),
+        }
+
+    return Case("kdtree_knn", f"k{k}", dataset, n, make, {"k": k, "queries": "every point"}, ("scipy-ckdtree", 1.0))
+
+
+def _kdtree_radius_case(dataset, n):
+    radius = neighbourhood_radius(dataset, n)
+
+    def make():
+        from solutions.nn import kdtree_build, kdtree_radius
+
+        xyz = cloud(dataset, n)
+        tree = kdtree_build(xyz, 16)
+        peers = _nn_peers(xyz)
+        peers["open3d"].fixed_radius_index(radius)
+        queries = o3d.core.Tensor(np.array(xyz))
+        return {
+            "reference": lambda: kdtree_radius(tree, xyz, xyz, radius),
+            "scipy-ckdtree": lambda: peers["scipy-ckdtree"].query_ball_point(xyz, radius, workers=-1),
+            "scipy-ckdtree-counts": lambda: peers["scipy-ckdtree"].query_ball_point(
+                xyz, radius, workers=-1, return_length=True
+            ),
+            "sklearn-kdtree": lambda: peers["sklearn-kdtree"].query_radius(xyz, radius),
+            "open3d": lambda: peers["open3d"].fixed_radius_search(queries, radius),
+        }
+
+    return Case("kdtree_radius", "k16", dataset, n, make, {"radius": radius}, ("scipy-ckdtree", 1.0))
+
+
+def _octree_radius_case(n):
+    def make():
+        from solutions.nn import kdtree_build, kdtree_radius, octree_build, octree_radius
+
+        xyz = cloud("scan", n)
+        octree, kd = octree_build(xyz, 32), kdtree_build(xyz, 16)
+        queries = xyz[:: max(1, n // 10_000)]
+        return {
+            "reference": lambda: octree_radius(octree, xyz, queries, 1.0),
+            "k-d tree (reference)": lambda: kdtree_radius(kd, xyz, queries, 1.0),
+        }
+
+    return Case(
+        "octree_radius", "1m", "scan", n, make, {"radius": 1.0, "queries": "10,000"}, ("k-d tree (reference)", 0.5)
+    )
+
+
+NN_CASES = ("kdtree_build", "kdtree_knn", "kdtree_radius", "octree_radius")
+
+
+def nn_cases(sizes=SIZES, datasets=DATASETS):
+    """Lecture 2's cases: the k-d tree on the cube and the scan, the octree on the scan."""
+    cases = []
+    for dataset in (d for d in datasets if d in ("cube", "scan")):
+        for n in sizes:
+            cases += [_kdtree_build_case(dataset, n), _kdtree_knn_case(dataset, n, 8)]
+            cases += [_kdtree_knn_case(dataset, n, 32), _kdtree_radius_case(dataset, n)] if n <= 100_000 else []
+    if "scan" in datasets:
+        cases += [_octree_radius_case(n) for n in sizes if n <= 100_000]
+    return cases
+
+
 def all_cases(sizes=SIZES, kernel_sizes=KERNEL_SIZES, datasets=DATASETS):
     """Every case, in the order they run."""
     cases = []
@@ -251,4 +359,4 @@ def all_cases(sizes=SIZES, kernel_sizes=KERNEL_SIZES, datasets=DATASETS):
         cases += [_kernel_pca_case(dataset, n) for n in kernel_sizes]
     cases += [_kernel_matrix_case(n) for n in kernel_sizes]
     cases += [_pca_case(n) for n in sizes] + [_chamfer_case(n) for n in sizes]
-    return cases
+    return cases + nn_cases(sizes, datasets)

@@ -165,12 +165,20 @@ def _label(case):
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
+    merge = "--merge" in argv
+    argv = [a for a in argv if a != "--merge"]
     if len(argv) != 2:
-        print("usage: python -m benchmarks.report RAW.json OUT_DIR", file=sys.stderr)
+        print("usage: python -m benchmarks.report RAW.json OUT_DIR [--merge]", file=sys.stderr)
         return 2
     raw = json.loads(Path(argv[0]).read_text())
     results = summarise(raw)
     out = Path(argv[1])
+    if merge and (out / "results.json").exists():
+        # A partial run (make bench BENCH_MERGE=1 BENCH_ARGS="-k ..."): its cases replace the same
+        # cases of the committed results; the others are kept as they were measured.
+        measured = {case["case"] for case in results["cases"]}
+        kept = [c for c in json.loads((out / "results.json").read_text())["cases"] if c["case"] not in measured]
+        results["cases"] = kept + results["cases"]
     out.mkdir(parents=True, exist_ok=True)
     (out / "results.json").write_text(json.dumps(results, indent=1) + "\n")
     (out / "results.md").write_text(markdown(results))

@@ -16,41 +16,49 @@ __all__ = ["build", "knn", "radius_count", "radius_fill", "offer"]
 
 
 @njit(cache=True, nogil=True, inline="always")
-def _less(points, axis, a, b):
-    """(coordinate, index) of point a before that of point b."""
-    ca, cb = points[a, axis], points[b, axis]
-    return ca < cb or (ca == cb and a < b)
+def _before(keys, ids, i, j):
+    """Entry i before entry j by (coordinate, index)."""
+    return keys[i] < keys[j] or (keys[i] == keys[j] and ids[i] < ids[j])
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _swap(keys, ids, i, j):
+    keys[i], keys[j] = keys[j], keys[i]
+    ids[i], ids[j] = ids[j], ids[i]
 
 
 @njit(cache=True, nogil=True)
-def _select(order, lo, hi, nth, points, axis):
-    """Reorder ``order[lo:hi]`` so that its first ``nth - lo`` entries are the smallest by (coordinate, index)."""
+def _select(keys, ids, nth):
+    """Reorder ``keys``/``ids`` together so that the first ``nth`` entries are the smallest by (key, id).
+
+    Works on a contiguous copy of the node's coordinates: no gather per comparison.
+    """
+    lo, hi = 0, keys.shape[0]
     while hi - lo > 2:
         mid = (lo + hi) // 2
         # Median of three as pivot, moved to hi - 1.
-        a, b, c = order[lo], order[mid], order[hi - 1]
-        if _less(points, axis, b, a):
-            a, b = b, a
-        if _less(points, axis, c, b):
-            b, c = c, b
-            if _less(points, axis, b, a):
-                a, b = b, a
-        order[lo], order[mid], order[hi - 1] = a, c, b
-        pivot = b
+        if _before(keys, ids, mid, lo):
+            _swap(keys, ids, mid, lo)
+        if _before(keys, ids, hi - 1, mid):
+            _swap(keys, ids, hi - 1, mid)
+            if _before(keys, ids, mid, lo):
+                _swap(keys, ids, mid, lo)
+        _swap(keys, ids, mid, hi - 1)
+        pivot_key, pivot_id = keys[hi - 1], ids[hi - 1]
         store = lo
         for i in range(lo, hi - 1):
-            if _less(points, axis, order[i], pivot):
-                order[i], order[store] = order[store], order[i]
+            if keys[i] < pivot_key or (keys[i] == pivot_key and ids[i] < pivot_id):
+                _swap(keys, ids, i, store)
                 store += 1
-        order[store], order[hi - 1] = order[hi - 1], order[store]
+        _swap(keys, ids, store, hi - 1)
         if store == nth:
             return
         if store < nth:
             lo = store + 1
         else:
             hi = store
-    if hi - lo == 2 and _less(points, axis, order[lo + 1], order[lo]):
-        order[lo], order[lo + 1] = order[lo + 1], order[lo]
+    if hi - lo == 2 and _before(keys, ids, lo + 1, lo):
+        _swap(keys, ids, lo, lo + 1)
 
 
 @njit(cache=True, nogil=True)
@@ -84,13 +92,17 @@ def build(points, leaf_size):
             continue
         a = depth % dim
         m = lo + (size + 1) // 2
-        _select(order, lo, hi, m, points, a)
-        below = points[order[lo], a]
-        for i in range(lo + 1, m):
-            below = max(below, points[order[i], a])
-        above = points[order[m], a]
-        for i in range(m + 1, hi):
-            above = min(above, points[order[i], a])
+        ids = order[lo:hi]  # a view: selected in place
+        keys = np.empty(size)
+        for i in range(size):
+            keys[i] = points[ids[i], a]
+        _select(keys, ids, m - lo)
+        below = keys[0]
+        for i in range(1, m - lo):
+            below = max(below, keys[i])
+        above = keys[m - lo]
+        for i in range(m - lo + 1, size):
+            above = min(above, keys[i])
         axis[node] = a
         split[node] = (below + above) / 2
         left[node] = count  # preorder: the left child comes next
