@@ -1,0 +1,57 @@
+"""The grader's own trees (grading/trees.py) agree with the reference, and its lying trees lie as the
+book's theorem needs: the rule's answer unchanged, brute force's changed."""
+
+import numpy as np
+import pytest
+
+from grading import trees
+from solutions import nn
+
+CLOUDS = {
+    "uniform": lambda rng: rng.uniform(size=(1500, 3)),
+    "grid": lambda rng: np.stack(np.meshgrid(*[np.arange(6.0)] * 3, indexing="ij"), -1).reshape(-1, 3),
+    "duplicates": lambda rng: np.repeat(rng.uniform(size=(100, 3)), 7, axis=0),
+    "flat 2-D": lambda rng: rng.normal(size=(700, 2)) * [10.0, 0.1],
+}
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_the_grader_builds_the_references_trees(name, rng):
+    points = CLOUDS[name](rng)
+    for leaf_size in (1, 5, 16):
+        expected, got = nn.kdtree_build(points, leaf_size), trees.kdtree(points, leaf_size)
+        assert all(np.array_equal(expected[k], got[k], equal_nan=True) for k in expected), (name, leaf_size)
+        if points.shape[1] >= 3:
+            expected, got = nn.octree_build(points, leaf_size), trees.octree(points, leaf_size, 1e-3)
+            assert all(np.array_equal(expected[k], got[k]) for k in expected), (name, leaf_size)
+
+
+@pytest.mark.parametrize("name", ["uniform", "grid", "duplicates"])
+def test_the_graders_searches_match_the_reference(name, rng):
+    points = CLOUDS[name](rng)
+    queries = np.vstack([points[:20], rng.uniform(points.min(0), points.max(0), size=(20, 3))])
+    kd, oc = nn.kdtree_build(points, 8), nn.octree_build(points, 8)
+    for expected, got in (
+        (nn.kdtree_knn(kd, points, queries, 7), trees.kdtree_search(kd, points, queries, k=7)),
+        (nn.kdtree_radius(kd, points, queries, 1.0), trees.kdtree_search(kd, points, queries, radius=1.0)),
+        (nn.octree_knn(oc, points, queries, 7), trees.octree_search(oc, points, queries, k=7)),
+        (nn.octree_radius(oc, points, queries, 1.0), trees.octree_search(oc, points, queries, radius=1.0)),
+    ):
+        assert all(np.array_equal(e, g) if e.dtype.kind == "i" else np.allclose(e, g) for e, g in zip(expected, got))
+
+
+def test_a_lying_tree_keeps_the_rules_answer_and_fools_brute_force(rng):
+    points = rng.uniform(size=(4096, 3))
+    for build, reach, search in (
+        (lambda: trees.kdtree(points, 8), lambda t, q: trees.kdtree_reach(t, points, q, k=4)[0], nn.kdtree_knn),
+        (lambda: trees.octree(points, 8, 1e-3), lambda t, q: trees.octree_reach(t, points, q, k=4)[0], nn.octree_knn),
+    ):
+        tree = build()
+        for query in rng.uniform(0.1, 0.9, size=(5, 3)):
+            reached = reach(tree, query)
+            nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
+            lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng)
+            assert len(decoys) > 10 * len(reached)
+            original = trees.brute_knn(points, query, 4)[0]
+            assert np.array_equal(search(tree, lying, query[None], 4)[0][0], original)  # the rule is not fooled
+            assert set(trees.brute_knn(lying, query, 4)[0]) <= set(decoys)  # brute force is
