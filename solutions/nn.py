@@ -21,7 +21,12 @@ from pcl_course.validation import (
 )
 from solutions._fast import kdtree as _kdtree
 from solutions._fast import octree as _octree
+from solutions._fast.order import morton_order
 from solutions._fast.threads import in_threads
+
+# Above this many queries, kNN visits them along a Z-order curve: consecutive queries then
+# walk the same nodes, which stay in cache (the answers are the same in any order).
+_LOCALITY_QUERIES = 20_000
 
 __all__ = [
     "knn_result_set",
@@ -170,9 +175,22 @@ def kdtree_knn(tree, points, queries, k):
     points, queries = _cloud_and_queries(points, queries, 1)
     arrays = _kdtree_arrays(tree, points)
     k = check_integer(k, "k", low=1, high=len(points))
+    return _knn_in_locality_order(_kdtree.knn, arrays, points, queries, k)
+
+
+def _knn_in_locality_order(kernel, arrays, points, queries, k):
+    """Run a kNN kernel over every core, on the queries in Z-order when there are many."""
+    permutation = None
+    if len(queries) >= _LOCALITY_QUERIES and queries.shape[1] >= 3:
+        permutation = morton_order(queries[:, :3])
+        queries = np.ascontiguousarray(queries[permutation])
     indices = np.empty((len(queries), k), dtype=np.int64)
     distances = np.empty((len(queries), k))
-    in_threads(_kdtree.knn, len(queries), (*arrays, points, queries, k), (indices, distances), grain=1024)
+    in_threads(kernel, len(queries), (*arrays, points, queries, k), (indices, distances), grain=1024)
+    if permutation is not None:
+        unsorted_indices, unsorted_distances = indices, distances
+        indices, distances = np.empty_like(indices), np.empty_like(distances)
+        indices[permutation], distances[permutation] = unsorted_indices, unsorted_distances
     return indices, distances
 
 
@@ -227,7 +245,4 @@ def octree_radius(tree, points, queries, radius):
 def octree_knn(tree, points, queries, k):
     arrays, xyz, queries = _octree_inputs(tree, points, queries)
     k = check_integer(k, "k", low=1, high=len(xyz))
-    indices = np.empty((len(queries), k), dtype=np.int64)
-    distances = np.empty((len(queries), k))
-    in_threads(_octree.knn, len(queries), (*arrays, xyz, queries, k), (indices, distances), grain=1024)
-    return indices, distances
+    return _knn_in_locality_order(_octree.knn, arrays, xyz, queries, k)
