@@ -356,9 +356,11 @@ def test_farthest_point_sampling_uses_euclidean_distance(impl):
 @pytest.mark.grades("farthest_point_sampling")
 @pytest.mark.points(1)
 def test_farthest_point_sampling_uses_only_xyz(impl):
-    points = np.array([[0.0, 0, 0, 0.0], [1.0, 0, 0, 100.0], [2.0, 0, 0, 0.0]])
-    result = impl.farthest_point_sampling(points, 2)
-    assert result.tolist() == [0, 2], f"extra columns must not count in the distance, got {result.tolist()}"
+    # x = 0..5 on a line, a large fourth column at 1 and 4. On xyz: 5 is farthest from 0; then 2 and 3
+    # tie at distance 2 from {0, 5}, and the lower index wins. Counting the column would pick 1 or 4.
+    points = np.column_stack([np.arange(6.0), np.zeros(6), np.zeros(6), [0.0, 100, 0, 0, 100, 0]])
+    result = impl.farthest_point_sampling(points, 3)
+    assert result.tolist() == [0, 5, 2], f"extra columns must not count in the distance, got {result.tolist()}"
 
 
 @pytest.mark.grades("farthest_point_sampling")

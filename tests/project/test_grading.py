@@ -285,7 +285,8 @@ def _is_interface_test(function):
 
 # Modules whose graded tests never call a second function of the submission (lecture 2's searches
 # run on the grader's own trees): their functions are degraded all at once, one grading per kind.
-DEGRADED_TOGETHER = ("nn",)
+# Not pca: the tests of kernel_pca_transform call kernel_pca. A test below keeps this list true.
+DEGRADED_TOGETHER = ("normals", "downsampling", "filters", "metrics", "nn")
 KINDS = ("zeros", "nan", "echo", "random")
 DEGENERATE = [(f, k) for f, m in GRADED_FUNCTIONS.items() if m not in DEGRADED_TOGETHER for k in KINDS]
 DEGENERATE += [(m, k) for m in DEGRADED_TOGETHER for k in KINDS]
@@ -328,6 +329,27 @@ def test_a_degenerate_answer_fails_every_test_of_values(function, kind, tmp_path
             t["name"] for t in own if t["status"] == "passed" and not _is_interface_test(tests[t["name"].split("[")[0]])
         ]
         assert not passed, f"a {kind} answer of {graded} passes tests of values: {passed}"
+
+
+def test_tests_of_modules_degraded_together_call_only_their_own_function():
+    for path in sorted((REPO_ROOT / "tests").glob("*/test_*.py")):
+        if path.parent.name not in ("graded", "hidden"):
+            continue
+        for node in ast.parse(path.read_text()).body:
+            marks = [
+                d
+                for d in getattr(node, "decorator_list", [])
+                if getattr(getattr(d, "func", None), "attr", "") == "grades"
+            ]
+            if not marks or GRADED_FUNCTIONS[marks[0].args[0].value] not in DEGRADED_TOGETHER:
+                continue
+            own = marks[0].args[0].value
+            called = {
+                n.attr
+                for n in ast.walk(node)
+                if isinstance(n, ast.Attribute) and getattr(n.value, "id", None) == "impl"
+            }
+            assert called <= {own}, f"{path.name}::{node.name} ({own}) calls {called - {own}}: degrade it alone"
 
 
 def test_tests_past_the_time_budget_score_zero_and_say_so(tmp_path):
