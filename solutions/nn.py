@@ -6,7 +6,6 @@ The trees and their searches are compiled (``solutions/_fast/kdtree.py`` and
 """
 
 import numpy as np
-from numba import njit
 
 from pcl_course import nn as _contract
 from pcl_course.validation import (
@@ -19,6 +18,7 @@ from pcl_course.validation import (
     check_radius,
     check_scalar,
 )
+from solutions._fast import bst as _bst
 from solutions._fast import kdtree as _kdtree
 from solutions._fast import octree as _octree
 from solutions._fast.order import morton_order
@@ -49,20 +49,6 @@ def _documented(function):
 # -- result set and binary search tree --------------------------------------------------------
 
 
-@njit(cache=True)
-def _result_set(distances, indices, k):
-    n = distances.shape[0]
-    held_s = np.empty(min(k, n))
-    held_i = np.empty(min(k, n), dtype=np.int64)
-    worst = np.full(n, np.inf)
-    count = 0
-    for j in range(n):
-        count = _kdtree.offer(distances[j], indices[j], held_s, held_i, count, min(k, n))
-        if count == k:
-            worst[j] = held_s[k - 1]
-    return held_i[:count], held_s[:count], worst
-
-
 @_documented
 def knn_result_set(distances, indices, k):
     distances = as_array(distances, "distances", ndim=1)
@@ -75,67 +61,13 @@ def knn_result_set(distances, indices, k):
     if len(np.unique(values)) != len(values):
         raise ValueError("indices must be distinct")
     k = check_integer(k, "k", low=1)
-    return _result_set(distances, values, k)
-
-
-@njit(cache=True)
-def _bst_insert_all(keys):
-    n = keys.shape[0]
-    left = np.full(n, -1, dtype=np.int64)
-    right = np.full(n, -1, dtype=np.int64)
-    for i in range(1, n):
-        node = 0
-        while True:
-            if keys[i] < keys[node]:
-                if left[node] < 0:
-                    left[node] = i
-                    break
-                node = left[node]
-            else:
-                if right[node] < 0:
-                    right[node] = i
-                    break
-                node = right[node]
-    return left, right
+    return _bst.result_set(distances, values, k)
 
 
 @_documented
 def bst_build(keys):
     keys = as_array(keys, "keys", ndim=1)
-    return _bst_insert_all(keys)
-
-
-@njit(cache=True)
-def _bst_search(keys, left, right, query, k):
-    held_s = np.empty(k)
-    held_i = np.empty(k, dtype=np.int64)
-    count = 0
-    worst = np.inf
-    # Frames: (node, state); state 0 = not entered, 1 = near side done.
-    stack_node = np.empty(keys.shape[0] + 1, dtype=np.int64)
-    stack_state = np.empty(keys.shape[0] + 1, dtype=np.int64)
-    stack_node[0], stack_state[0] = 0, 0
-    top = 1
-    while top > 0:
-        node, state = stack_node[top - 1], stack_state[top - 1]
-        gap = abs(keys[node] - query)
-        go_left = query < keys[node]
-        if state == 0:
-            count = _kdtree.offer(gap, node, held_s, held_i, count, k)
-            if count == k:
-                worst = held_s[k - 1]
-            stack_state[top - 1] = 1
-            near = left[node] if go_left else right[node]
-            if near >= 0:
-                stack_node[top], stack_state[top] = near, 0
-                top += 1
-            continue
-        top -= 1
-        far = right[node] if go_left else left[node]
-        if far >= 0 and gap <= worst:
-            stack_node[top], stack_state[top] = far, 0
-            top += 1
-    return held_i, held_s
+    return _bst.insert_all(keys)
 
 
 @_documented
@@ -144,7 +76,7 @@ def bst_knn(keys, left, right, query, k):
     left, right = check_bst(left, right, len(keys))
     query = check_scalar(query, "query")
     k = check_integer(k, "k", low=1, high=len(keys))
-    return _bst_search(keys, left, right, query, k)
+    return _bst.search(keys, left, right, query, k)
 
 
 # -- k-d tree ----------------------------------------------------------------------------------

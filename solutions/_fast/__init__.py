@@ -11,6 +11,9 @@ module      what
 ``eig3``    closed-form smallest eigenpair of a 3x3 symmetric matrix; patch normals
 ``voxel``   voxel keys, hash grouping, reservoir choice, the lecture's hash table
 ``fps``     exact farthest point sampling over buckets
+``kdtree``  lecture 2's k-d tree: median build, kNN and radius searches
+``octree``  lecture 2's octree: build, radius search, kNN with early termination
+``bst``     lecture 2's result set and binary search tree
 ==========  ============================================================
 
 Why a package of their own, always imported under the same names
