@@ -5,6 +5,9 @@ The trees and their searches are compiled (``solutions/_fast/kdtree.py`` and
 (``pcl_course/nn.py``), which state the contract.
 """
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 
 from pcl_course import nn as _contract
@@ -126,16 +129,19 @@ def _knn_in_locality_order(kernel, arrays, points, queries, k):
     return indices, distances
 
 
-def _csr(count_kernel, fill_kernel, inputs, n_queries):
-    """Run a radius search in two passes (counts, then sorted rows) into CSR arrays."""
-    counts = np.zeros(n_queries, dtype=np.int64)
-    in_threads(count_kernel, n_queries, inputs, (counts,), grain=1024)
+def _csr(rows_kernel, inputs, n_queries):
+    """A radius search into CSR arrays: slices of queries on every core, each in one pass."""
+    cores = os.cpu_count() or 1
+    slices = max(1, min(16 * cores, n_queries // 1024))
+    bounds = np.linspace(0, n_queries, slices + 1).astype(np.int64)
+    if slices == 1:
+        parts = [rows_kernel(*inputs, 0, n_queries)]
+    else:
+        with ThreadPoolExecutor(cores) as pool:
+            parts = list(pool.map(lambda i: rows_kernel(*inputs, bounds[i], bounds[i + 1]), range(slices)))
     indptr = np.zeros(n_queries + 1, dtype=np.int64)
-    np.cumsum(counts, out=indptr[1:])
-    indices = np.empty(indptr[-1], dtype=np.int64)
-    distances = np.empty(indptr[-1])
-    in_threads(fill_kernel, n_queries, (*inputs, indptr), (indices, distances), grain=1024)
-    return indptr, indices, distances
+    np.cumsum(np.concatenate([part[0] for part in parts]), out=indptr[1:])
+    return indptr, np.concatenate([part[1] for part in parts]), np.concatenate([part[2] for part in parts])
 
 
 @_documented
@@ -143,7 +149,7 @@ def kdtree_radius(tree, points, queries, radius):
     points, queries = _cloud_and_queries(points, queries, 1)
     arrays = _kdtree_arrays(tree, points)
     radius = check_radius(radius)
-    return _csr(_kdtree.radius_count, _kdtree.radius_fill, (*arrays, points, queries, radius**2), len(queries))
+    return _csr(_kdtree.radius_rows, (*arrays, points, queries, radius**2), len(queries))
 
 
 # -- octree ------------------------------------------------------------------------------------
@@ -170,7 +176,7 @@ def _octree_inputs(tree, points, queries):
 def octree_radius(tree, points, queries, radius):
     arrays, xyz, queries = _octree_inputs(tree, points, queries)
     radius = check_radius(radius)
-    return _csr(_octree.radius_count, _octree.radius_fill, (*arrays, xyz, queries, radius**2), len(queries))
+    return _csr(_octree.radius_rows, (*arrays, xyz, queries, radius**2), len(queries))
 
 
 @_documented

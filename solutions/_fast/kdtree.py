@@ -12,7 +12,7 @@ comparison with the last entry.
 import numpy as np
 from numba import njit
 
-__all__ = ["build", "knn", "radius_count", "radius_fill", "offer"]
+__all__ = ["build", "knn", "radius_rows", "offer"]
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -222,30 +222,27 @@ def sort_pairs(s, index):
 
 
 @njit(cache=True, nogil=True)
-def radius_count(order, start, stop, axis, split, left, right, points, queries, r2, first, last, counts):
-    """``counts[qi]``: neighbours of each query of ``queries[first:last]`` within sqrt(r2)."""
+def radius_rows(order, start, stop, axis, split, left, right, points, queries, r2, first, last):
+    """CSR rows of ``queries[first:last]`` in one pass: (counts, indices, distances), each row sorted."""
+    counts = np.zeros(last - first, dtype=np.int64)
+    all_i = np.empty(max(64, 16 * (last - first)), dtype=np.int64)
+    all_d = np.empty(all_i.shape[0])
     out_s = np.empty(64)
     out_i = np.empty(64, dtype=np.int64)
+    filled = 0
     for qi in range(first, last):
         c, out_s, out_i = _radius_walk(
             order, start, stop, axis, split, left, right, points, queries[qi], r2, out_s, out_i
         )
-        counts[qi] = c
-
-
-@njit(cache=True, nogil=True)
-def radius_fill(
-    order, start, stop, axis, split, left, right, points, queries, r2, indptr, first, last, indices, distances
-):
-    """Fill the CSR rows of ``queries[first:last]`` (``indptr`` from :func:`radius_count`), each sorted."""
-    out_s = np.empty(64)
-    out_i = np.empty(64, dtype=np.int64)
-    for qi in range(first, last):
-        c, out_s, out_i = _radius_walk(
-            order, start, stop, axis, split, left, right, points, queries[qi], r2, out_s, out_i
-        )
+        if filled + c > all_i.shape[0]:
+            size = max(2 * all_i.shape[0], filled + c)
+            grown_i, grown_d = np.empty(size, dtype=np.int64), np.empty(size)
+            grown_i[:filled], grown_d[:filled] = all_i[:filled], all_d[:filled]
+            all_i, all_d = grown_i, grown_d
         rank = sort_pairs(out_s[:c], out_i[:c])
-        base = indptr[qi]
         for j in range(c):
-            indices[base + j] = out_i[rank[j]]
-            distances[base + j] = np.sqrt(out_s[rank[j]])
+            all_i[filled + j] = out_i[rank[j]]
+            all_d[filled + j] = np.sqrt(out_s[rank[j]])
+        filled += c
+        counts[qi - first] = c
+    return counts, all_i[:filled], all_d[:filled]

@@ -9,9 +9,9 @@ visiting its subtree, and no node stores a list of points.
 import numpy as np
 from numba import njit
 
-from solutions._fast.kdtree import offer
+from solutions._fast.kdtree import offer, sort_pairs
 
-__all__ = ["build", "radius_count", "radius_fill", "knn"]
+__all__ = ["build", "radius_rows", "knn"]
 
 
 @njit(cache=True, nogil=True)
@@ -179,28 +179,28 @@ def _radius_walk(order, start, stop, center, extent, children, xyz, query, r2, o
 
 
 @njit(cache=True, nogil=True)
-def radius_count(order, start, stop, center, extent, children, xyz, queries, r2, first, last, counts):
+def radius_rows(order, start, stop, center, extent, children, xyz, queries, r2, first, last):
+    """CSR rows of ``queries[first:last]`` in one pass: (counts, indices, distances), each row sorted."""
+    counts = np.zeros(last - first, dtype=np.int64)
+    all_i = np.empty(max(64, 16 * (last - first)), dtype=np.int64)
+    all_d = np.empty(all_i.shape[0])
     out_s = np.empty(64)
     out_i = np.empty(64, dtype=np.int64)
+    filled = 0
     for qi in range(first, last):
         c, out_s, out_i = _radius_walk(order, start, stop, center, extent, children, xyz, queries[qi], r2, out_s, out_i)
-        counts[qi] = c
-
-
-@njit(cache=True, nogil=True)
-def radius_fill(
-    order, start, stop, center, extent, children, xyz, queries, r2, indptr, first, last, indices, distances
-):
-    out_s = np.empty(64)
-    out_i = np.empty(64, dtype=np.int64)
-    for qi in range(first, last):
-        c, out_s, out_i = _radius_walk(order, start, stop, center, extent, children, xyz, queries[qi], r2, out_s, out_i)
-        by_index = np.argsort(out_i[:c])
-        rank = by_index[np.argsort(out_s[:c][by_index], kind="mergesort")]
-        base = indptr[qi]
+        if filled + c > all_i.shape[0]:
+            size = max(2 * all_i.shape[0], filled + c)
+            grown_i, grown_d = np.empty(size, dtype=np.int64), np.empty(size)
+            grown_i[:filled], grown_d[:filled] = all_i[:filled], all_d[:filled]
+            all_i, all_d = grown_i, grown_d
+        rank = sort_pairs(out_s[:c], out_i[:c])
         for j in range(c):
-            indices[base + j] = out_i[rank[j]]
-            distances[base + j] = np.sqrt(out_s[rank[j]])
+            all_i[filled + j] = out_i[rank[j]]
+            all_d[filled + j] = np.sqrt(out_s[rank[j]])
+        filled += c
+        counts[qi - first] = c
+    return counts, all_i[:filled], all_d[:filled]
 
 
 @njit(cache=True, nogil=True)
