@@ -8,10 +8,10 @@ from grading import trees
 from solutions import nn
 
 CLOUDS = {
-    "uniform": lambda rng: rng.uniform(size=(1500, 3)),
+    "uniform": lambda rng: rng.uniform(size=(600, 3)),
     "grid": lambda rng: np.stack(np.meshgrid(*[np.arange(6.0)] * 3, indexing="ij"), -1).reshape(-1, 3),
-    "duplicates": lambda rng: np.repeat(rng.uniform(size=(100, 3)), 7, axis=0),
-    "flat 2-D": lambda rng: rng.normal(size=(700, 2)) * [10.0, 0.1],
+    "duplicates": lambda rng: np.repeat(rng.uniform(size=(60, 3)), 5, axis=0),
+    "flat 2-D": lambda rng: rng.normal(size=(400, 2)) * [10.0, 0.1],
 }
 
 
