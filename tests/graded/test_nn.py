@@ -342,9 +342,9 @@ def test_kdtree_build_edge_cases_and_bad_input(impl):
 @pytest.mark.points(4)
 def test_kdtree_knn_matches_brute_force(impl):
     for points, queries, k, leaf in (
-        (cube(2000, 31), cube(150, 32), 8, 16),
-        (scan_like(2000, 33), scan_like(150, 34) + 0.05, 5, 8),
-        (cube(1500, 35, dim=2), cube(100, 36, dim=2) * 1.2, 12, 4),
+        (cube(2000, 31), cube(60, 32), 8, 16),
+        (scan_like(2000, 33), scan_like(60, 34) + 0.05, 5, 8),
+        (cube(1500, 35, dim=2), cube(50, 36, dim=2) * 1.2, 12, 4),
     ):
         tree = kd_tree(impl, points, leaf)
         check_knn(*impl.kdtree_knn(tree, points, queries, k), *brute_knn(points, queries, k), "kdtree_knn")
@@ -355,7 +355,7 @@ def test_kdtree_knn_matches_brute_force(impl):
 def test_kdtree_knn_self_far_and_large_coordinate_queries(impl):
     points = cube(1000, 37) + [4.0e6, -2.0e6, 1.0e3]  # UTM-like coordinates
     tree = kd_tree(impl, points, 8)
-    queries = np.vstack([points[:50], points[:20] + [50.0, 0, 0]])
+    queries = np.vstack([points[:30], points[:10] + [50.0, 0, 0]])
     check_knn(*impl.kdtree_knn(tree, points, queries, 6), *brute_knn(points, queries, 6), "kdtree_knn")
     indices, distances = impl.kdtree_knn(tree, points, points[:5], 1)
     assert indices[:, 0].tolist() == list(range(5)) and np.all(distances == 0), "a point is its own nearest"
@@ -394,9 +394,9 @@ def test_kdtree_knn_bad_input_and_no_queries(impl):
 @pytest.mark.points(3)
 def test_kdtree_radius_matches_brute_force(impl):
     for points, queries, radius, leaf in (
-        (cube(2000, 41), cube(100, 42), 0.2, 16),
-        (scan_like(2000, 43), scan_like(100, 44), 0.5, 8),
-        (cube(1000, 45, dim=2), cube(80, 46, dim=2), 0.1, 3),
+        (cube(2000, 41), cube(50, 42), 0.2, 16),
+        (scan_like(2000, 43), scan_like(50, 44), 0.5, 8),
+        (cube(1000, 45, dim=2), cube(40, 46, dim=2), 0.1, 3),
     ):
         tree = kd_tree(impl, points, leaf)
         check_csr(impl.kdtree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
@@ -500,8 +500,8 @@ def test_octree_build_edge_cases_and_bad_input(impl):
 @pytest.mark.points(4)
 def test_octree_radius_matches_brute_force(impl):
     for points, queries, radius, leaf in (
-        (cube(2000, 61), cube(100, 62) * 1.3, 0.25, 8),  # some queries outside the root cube
-        (scan_like(2000, 63), scan_like(100, 64), 0.6, 16),
+        (cube(2000, 61), cube(50, 62) * 1.3, 0.25, 8),  # some queries outside the root cube
+        (scan_like(2000, 63), scan_like(50, 64), 0.6, 16),
         (cube(1000, 65), cube(30, 66), 1.5, 4),  # large balls: whole octants inside
     ):
         tree = oc_tree(impl, points, leaf)
@@ -535,8 +535,8 @@ def test_octree_radius_rejects_bad_input(impl):
 @pytest.mark.points(4)
 def test_octree_knn_matches_brute_force(impl):
     for points, queries, k, leaf in (
-        (cube(2000, 71), cube(120, 72) * 1.2, 8, 8),
-        (scan_like(2000, 73), scan_like(120, 74), 5, 16),
+        (cube(2000, 71), cube(50, 72) * 1.2, 8, 8),
+        (scan_like(2000, 73), scan_like(50, 74), 5, 16),
         (cube(300, 75), cube(20, 76), 300, 4),  # k = N
     ):
         tree = oc_tree(impl, points, leaf)
