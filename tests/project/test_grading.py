@@ -176,8 +176,15 @@ DIAGNOSIS_FLOOR = 0.9  # of the mutants, named by their diagnosis
 # each of several functions in one generated module, one grading for them all. Sound where no test
 # calls a second function (DEGRADED_TOGETHER, below, and its guard). Mistakes found in the module's
 # source (a forbidden API, a signature) stay alone: the generated module's source is not theirs.
-GRADED_TOGETHER = ("normals", "downsampling", "filters", "metrics", "nn")
+GRADED_TOGETHER = ("pca", "normals", "downsampling", "filters", "metrics", "nn")
 READ_FROM_SOURCE = ("forbidden_api", "signature")
+# Functions whose tests call another graded function: never in one batch with it (a wrong kernel_pca
+# would make kernel_pca_transform's tests fail for a reason not its own).
+KEPT_APART = {"kernel_pca_transform": "kernel_pca"}
+
+
+def _apart(a, b):
+    return KEPT_APART.get(a) == b or KEPT_APART.get(b) == a
 
 
 def _module_of(path):
@@ -192,7 +199,11 @@ def _batches(files):
             alone.append([path])
             continue
         groups = batches.setdefault(_module_of(path), [])
-        group = next((g for g in groups if path.parent.name not in {p.parent.name for p in g}), None)
+        function = path.parent.name
+        group = next(
+            (g for g in groups if all(p.parent.name != function and not _apart(p.parent.name, function) for p in g)),
+            None,
+        )
         if group is None:
             groups.append([path])
         else:
@@ -443,6 +454,28 @@ def test_tests_of_modules_degraded_together_call_only_their_own_function():
                 if isinstance(n, ast.Attribute) and getattr(n.value, "id", None) == "impl"
             }
             assert called <= {own}, f"{path.name}::{node.name} ({own}) calls {called - {own}}: degrade it alone"
+
+
+def test_functions_graded_together_are_kept_apart_where_a_test_calls_another():
+    for path in sorted((REPO_ROOT / "tests").glob("*/test_*.py")):
+        if path.parent.name not in ("graded", "hidden"):
+            continue
+        for node in ast.parse(path.read_text()).body:
+            marks = [
+                d
+                for d in getattr(node, "decorator_list", [])
+                if getattr(getattr(d, "func", None), "attr", "") == "grades"
+            ]
+            if not marks or GRADED_FUNCTIONS[marks[0].args[0].value] not in GRADED_TOGETHER:
+                continue
+            own = marks[0].args[0].value
+            called = {
+                n.attr
+                for n in ast.walk(node)
+                if isinstance(n, ast.Attribute) and getattr(n.value, "id", None) == "impl"
+            }
+            for other in called - {own}:
+                assert _apart(own, other), f"{path.name}::{node.name} ({own}) calls {other}: add it to KEPT_APART"
 
 
 def test_tests_past_the_time_budget_score_zero_and_say_so(tmp_path):
