@@ -410,11 +410,14 @@ def _csr_rows(rows):
     return indptr, indices, distances
 
 
-def kdtree_search(tree, points, queries, k=None, radius=None, strict=False, far_first=False, prune=True):
+def kdtree_search(
+    tree, points, queries, k=None, radius=None, strict=False, far_first=False, prune=True, unsquared=False
+):
     """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
 
     The flags give known wrong versions: ``strict`` (the far child only if
-    ``d2 < w2``, radius ``s < r2``), ``far_first``, ``prune=False`` (every leaf).
+    ``d2 < w2``, radius ``s < r2``), ``far_first``, ``prune=False`` (every leaf),
+    ``unsquared`` (the far child if ``|d| <= w2``: a distance against a squared one).
     """
     points = np.asarray(points, dtype=float)
     queries = _as_rows(queries, points.shape[1])
@@ -447,7 +450,8 @@ def kdtree_search(tree, points, queries, k=None, radius=None, strict=False, far_
                 near, far = far, near
             visit(near)
             w2 = best.worst if best is not None else radius**2
-            if not prune or diff * diff < w2 or (not strict and diff * diff == w2):
+            gap = abs(diff) if unsquared else diff * diff
+            if not prune or gap < w2 or (not strict and gap == w2):
                 visit(far)
 
         visit(0)

@@ -173,11 +173,11 @@ BST_KNN = Model(
 # -- k-d tree -------------------------------------------------------------------------------------
 
 
-def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="depth"):
+def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="depth", partition="rank"):
     points = valid_points(points)
     if not isinstance(leaf_size, (int, np.integer)) or leaf_size < 1:
         raise ValueError("leaf_size")
-    if median == "ceil" and split == "mean" and axis_rule == "depth":
+    if median == "ceil" and split == "mean" and axis_rule == "depth" and partition == "rank":
         return trees.kdtree(points, int(leaf_size))
     n, dim = points.shape
     nodes, order = [], []
@@ -200,8 +200,16 @@ def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="d
                 if split == "mean"
                 else points[ranked[m], axis]
             )
-            nodes[node][4] = grow(ranked[:m], depth + 1)
-            nodes[node][5] = grow(ranked[m:], depth + 1)
+            lower, upper = ranked[:m], ranked[m:]
+            if partition == "value":  # by comparing with the split: ties all go right
+                lower = [i for i in ranked if points[i, axis] < nodes[node][3]]
+                upper = [i for i in ranked if points[i, axis] >= nodes[node][3]]
+            if not lower or not upper:  # the student's guard against endless splitting: a leaf
+                nodes[node][2:4] = [-1, math.nan]
+                order.extend(sorted(indices))
+            else:
+                nodes[node][4] = grow(lower, depth + 1)
+                nodes[node][5] = grow(upper, depth + 1)
         nodes[node][1] = len(order)
         return node
 
@@ -232,6 +240,12 @@ KDTREE_BUILD = Model(
             "axis_by_spread",
             "the contract's axis is depth % D (round robin), not the axis of largest spread",
             lambda points, leaf_size=16: kdtree_build(points, leaf_size, axis_rule="spread"),
+        ),
+        Mistake(
+            "value_split",
+            "the left child takes the first m = ceil(n / 2) points of the order by (coordinate, index), not the "
+            "points below the split: equal coordinates fall on both sides of it, or duplicates would never split",
+            lambda points, leaf_size=16: kdtree_build(points, leaf_size, partition="value"),
         ),
     ),
 )
@@ -274,6 +288,12 @@ KDTREE_KNN = Model(
             "visit the far child when (q[axis] - split) ** 2 <= w2, inclusive: equal coordinates lie on both "
             "sides of a split, so a tie at the k-th distance can be there",
             lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, strict=True),
+        ),
+        Mistake(
+            "unsquared_bound",
+            "compare like with like: the far child is visited when (q[axis] - split) ** 2 <= w2, the squared "
+            "worst distance, not when |q[axis] - split| <= w2",
+            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, unsquared=True),
         ),
     ),
 )
