@@ -9,7 +9,7 @@ from scipy.spatial import cKDTree
 
 from pcl_course.validation import as_points, check_integer, check_positive
 
-__all__ = ["knn", "radius_neighbors"]
+__all__ = ["knn", "radius_neighbors", "scipy_kdtree"]
 
 
 def knn(points, k, queries=None, include_self=True, workers=1):
@@ -70,3 +70,51 @@ def radius_neighbors(points, radius, queries=None, workers=1):
     queries = points if queries is None else as_points(queries, "queries")[:, :3]
     lists = cKDTree(points).query_ball_point(queries, r=radius, workers=workers, return_sorted=True)
     return [np.asarray(row, dtype=np.int64) for row in lists]
+
+
+def scipy_kdtree(points, leaf_size=16, balanced_tree=True):
+    """SciPy's k-d tree of ``points``, in the layout of ``pcl_course.nn.kdtree_build``.
+
+    For comparing split rules: with ``balanced_tree=True`` (SciPy's default)
+    a node splits at the median of its axis of largest spread; with ``False``,
+    at the middle of its cell's longest side, slid to the nearest point if a
+    side would be empty (sliding midpoint). Neither is the course's rule.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+    leaf_size : int, default 16
+        SciPy's ``leafsize``: nodes of at most this many points are leaves.
+    balanced_tree : bool, default True
+
+    Returns
+    -------
+    dict of str to ndarray
+        ``order``, ``start``, ``stop``, ``axis``, ``split``, ``left``, ``right``
+        in preorder (``axis`` is -1 at a leaf), as ``kdtree_build`` returns.
+    """
+    points = np.asarray(points, dtype=float)
+    if points.ndim != 2 or len(points) == 0:
+        raise ValueError(f"points must be a non-empty (N, D) array, got shape {points.shape}")
+    leaf_size = check_integer(leaf_size, "leaf_size", low=1)
+    tree = cKDTree(points, leafsize=leaf_size, balanced_tree=bool(balanced_tree))
+    columns = {key: [] for key in ("start", "stop", "axis", "split", "left", "right")}
+    stack = [(tree.tree, -1, "")]  # (node, parent id, which child of the parent)
+    while stack:  # preorder: a node, its lesser subtree, its greater subtree
+        node, parent, side = stack.pop()
+        node_id = len(columns["start"])
+        if parent >= 0:
+            columns[side][parent] = node_id
+        leaf = node.split_dim < 0
+        values = (node.start_idx, node.end_idx, -1 if leaf else node.split_dim, np.nan if leaf else node.split, -1, -1)
+        for key, value in zip(columns, values):
+            columns[key].append(value)
+        if not leaf:
+            stack += [(node.greater, node_id, "right"), (node.lesser, node_id, "left")]
+    order = np.array(tree.indices, dtype=np.int64)
+    for start, stop, axis in zip(columns["start"], columns["stop"], columns["axis"]):
+        if axis < 0:  # a leaf's points in increasing index, as in the course's layout
+            order[start:stop] = np.sort(order[start:stop])
+    layout = {"order": order}
+    layout.update({key: np.array(values, dtype=float if key == "split" else np.int64) for key, values in columns.items()})
+    return layout

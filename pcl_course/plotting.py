@@ -938,7 +938,7 @@ def bst_drawing(keys, left, right, query, neighbours, figsize=(9, 3.6)):
     plt.show()
 
 
-def kdtree_partitions(panels, query, k, figsize=(11, 5.2)):
+def kdtree_partitions(panels, query, k, figsize=(11, 5.2), columns=None):
     """2-D k-d tree partitions side by side, with one query's k-nearest ball.
 
     Leaves whose cell meets the ball (every exact search must read them) are
@@ -950,13 +950,17 @@ def kdtree_partitions(panels, query, k, figsize=(11, 5.2)):
         Title -> a 2-D cloud (N, 2) and a k-d tree of it.
     query : array_like of shape (2,)
     k : int
+    columns : int, optional
+        Panels per row (all in one row by default).
     """
     import matplotlib.pyplot as plt
     from matplotlib.patches import Circle, Rectangle
 
-    fig, axes = plt.subplots(1, len(panels), figsize=figsize, squeeze=False)
+    columns = len(panels) if columns is None else columns
+    rows = -(-len(panels) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=figsize, squeeze=False)
     query = np.asarray(query, dtype=float)
-    for ax, (title, (points, tree)) in zip(axes[0], panels.items()):
+    for ax, (title, (points, tree)) in zip(axes.ravel(), panels.items()):
         lower, upper = points.min(axis=0), points.max(axis=0)
         radius = np.sort(np.linalg.norm(points - query, axis=1))[k - 1]
         cells = kdtree_leaf_cells(tree, lower, upper)
