@@ -116,5 +116,7 @@ def scipy_kdtree(points, leaf_size=16, balanced_tree=True):
         if axis < 0:  # a leaf's points in increasing index, as in the course's layout
             order[start:stop] = np.sort(order[start:stop])
     layout = {"order": order}
-    layout.update({key: np.array(values, dtype=float if key == "split" else np.int64) for key, values in columns.items()})
+    layout.update(
+        {key: np.array(values, dtype=float if key == "split" else np.int64) for key, values in columns.items()}
+    )
     return layout

@@ -55,3 +55,25 @@ def test_a_lying_tree_keeps_the_rules_answer_and_fools_brute_force(rng):
             original = trees.brute_knn(points, query, 4)[0]
             assert np.array_equal(search(tree, lying, query[None], 4)[0][0], original)  # the rule is not fooled
             assert set(trees.brute_knn(lying, query, 4)[0]) <= set(decoys)  # brute force is
+
+
+@pytest.mark.parametrize("balanced", [True, False])
+@pytest.mark.parametrize("name", ["uniform", "duplicates", "flat 2-D"])
+def test_scipy_trees_in_the_course_layout_are_valid_trees_that_search_right(name, balanced, rng):
+    """The book's split-rule comparison searches SciPy's trees with the course's own search."""
+    from pcl_course.neighbors import scipy_kdtree
+    from pcl_course.validation import check_kdtree
+
+    points = CLOUDS[name](rng)
+    tree = scipy_kdtree(points, 8, balanced_tree=balanced)
+    check_kdtree(tree, len(points), points.shape[1])
+    for node in np.flatnonzero(tree["axis"] >= 0):
+        axis, split = tree["axis"][node], tree["split"][node]
+        left, right = (
+            tree["order"][tree["start"][c] : tree["stop"][c]] for c in (tree["left"][node], tree["right"][node])
+        )
+        assert np.all(points[left, axis] <= split) and np.all(points[right, axis] >= split)
+    queries = np.vstack([points[:10], rng.uniform(points.min(0), points.max(0), size=(10, points.shape[1]))])
+    expected = trees.kdtree_search(nn.kdtree_build(points, 8), points, queries, k=5)
+    got = nn.kdtree_knn(tree, points, queries, 5)
+    assert np.array_equal(expected[0], got[0]) and np.allclose(expected[1], got[1])
