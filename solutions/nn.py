@@ -25,6 +25,7 @@ from solutions._fast import bst as _bst
 from solutions._fast import kdtree as _kdtree
 from solutions._fast import octree as _octree
 from solutions._fast.order import morton_order
+from solutions._fast.rows import unpermute_rows
 from solutions._fast.threads import in_threads
 
 # Above this many queries, kNN visits them along a Z-order curve: consecutive queries then
@@ -101,8 +102,9 @@ def kdtree_build(points, leaf_size=16):
 
 
 def _kdtree_arrays(tree, points):
+    """The tree's arrays for the kernels, and the size of a search's stack."""
     arrays = check_kdtree(tree, len(points), points.shape[1])
-    return tuple(arrays[key] for key in _KDTREE_KEYS)
+    return (*(arrays[key] for key in _KDTREE_KEYS), _kdtree.stack_size(arrays["left"], arrays["right"]))
 
 
 @_documented
@@ -129,6 +131,15 @@ def _knn_in_locality_order(kernel, arrays, points, queries, k):
     return indices, distances
 
 
+def _csr_in_locality_order(rows_kernel, arrays, points, queries, r2):
+    """A radius search into CSR arrays, on the queries in Z-order when there are many."""
+    if len(queries) < _LOCALITY_QUERIES or queries.shape[1] < 3:
+        return _csr(rows_kernel, (*arrays, points, queries, r2), len(queries))
+    permutation = morton_order(queries[:, :3])
+    rows = _csr(rows_kernel, (*arrays, points, np.ascontiguousarray(queries[permutation]), r2), len(queries))
+    return unpermute_rows(*rows, permutation)
+
+
 def _csr(rows_kernel, inputs, n_queries):
     """A radius search into CSR arrays: slices of queries on every core, each in one pass."""
     cores = os.cpu_count() or 1
@@ -149,7 +160,7 @@ def kdtree_radius(tree, points, queries, radius):
     points, queries = _cloud_and_queries(points, queries, 1)
     arrays = _kdtree_arrays(tree, points)
     radius = check_radius(radius)
-    return _csr(_kdtree.radius_rows, (*arrays, points, queries, radius**2), len(queries))
+    return _csr_in_locality_order(_kdtree.radius_rows, arrays, points, queries, radius**2)
 
 
 # -- octree ------------------------------------------------------------------------------------
@@ -169,14 +180,15 @@ def _octree_inputs(tree, points, queries):
     points, queries = _cloud_and_queries(points, queries, 3)
     arrays = check_octree(tree, len(points))
     xyz = np.ascontiguousarray(points[:, :3])
-    return tuple(arrays[key] for key in _OCTREE_KEYS), xyz, np.ascontiguousarray(queries[:, :3])
+    stack_size = _octree.stack_size(arrays["children"])
+    return (*(arrays[key] for key in _OCTREE_KEYS), stack_size), xyz, np.ascontiguousarray(queries[:, :3])
 
 
 @_documented
 def octree_radius(tree, points, queries, radius):
     arrays, xyz, queries = _octree_inputs(tree, points, queries)
     radius = check_radius(radius)
-    return _csr(_octree.radius_rows, (*arrays, xyz, queries, radius**2), len(queries))
+    return _csr_in_locality_order(_octree.radius_rows, arrays, xyz, queries, radius**2)
 
 
 @_documented

@@ -13,6 +13,7 @@ module      what
 ``fps``     exact farthest point sampling over buckets
 ``kdtree``  lecture 2's k-d tree: median build, kNN and radius searches
 ``octree``  lecture 2's octree: build, radius search, kNN with early termination
+``rows``    the trees' shared pieces: distances, sorted CSR rows, rows un-permuted
 ``bst``     lecture 2's result set and binary search tree
 ==========  ============================================================
 

@@ -12,7 +12,9 @@ comparison with the last entry.
 import numpy as np
 from numba import njit
 
-__all__ = ["build", "knn", "radius_rows", "offer"]
+from solutions._fast.rows import append_row, squared_distance
+
+__all__ = ["build", "knn", "radius_rows", "offer", "stack_size"]
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -132,20 +134,11 @@ def offer(s, index, held_s, held_i, count, k):
     return count
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _squared_distance(points, index, query):
-    s = 0.0
-    for j in range(query.shape[0]):
-        d = points[index, j] - query[j]
-        s += d * d
-    return s
-
-
 @njit(cache=True, nogil=True)
-def knn(order, start, stop, axis, split, left, right, points, queries, k, first, last, indices, distances):
+def knn(order, start, stop, axis, split, left, right, stack_size, points, queries, k, first, last, indices, distances):
     """k nearest neighbours of ``queries[first:last]`` into ``indices``/``distances`` (the contract's rule)."""
-    stack_node = np.empty(128, dtype=np.int64)
-    stack_d2 = np.empty(128)
+    stack_node = np.empty(stack_size, dtype=np.int64)  # never grown: a reassigned array slows every access
+    stack_d2 = np.empty(stack_size)
     held_s = np.empty(k)
     held_i = np.empty(k, dtype=np.int64)
     for qi in range(first, last):
@@ -163,15 +156,12 @@ def knn(order, start, stop, axis, split, left, right, points, queries, k, first,
             if a < 0:
                 for position in range(start[node], stop[node]):
                     index = order[position]
-                    count = offer(_squared_distance(points, index, query), index, held_s, held_i, count, k)
+                    count = offer(squared_distance(points, index, query), index, held_s, held_i, count, k)
                 if count == k:
                     worst = held_s[k - 1]
                 continue
             diff = query[a] - split[node]
             near, far = (left[node], right[node]) if diff <= 0 else (right[node], left[node])
-            if top + 2 > stack_node.shape[0]:
-                stack_node = np.concatenate((stack_node, np.empty_like(stack_node)))
-                stack_d2 = np.concatenate((stack_d2, np.empty_like(stack_d2)))
             stack_node[top], stack_d2[top] = far, diff * diff
             stack_node[top + 1], stack_d2[top + 1] = near, 0.0
             top += 2
@@ -181,9 +171,13 @@ def knn(order, start, stop, axis, split, left, right, points, queries, k, first,
 
 
 @njit(cache=True, nogil=True)
-def _radius_walk(order, start, stop, axis, split, left, right, points, query, r2, out_s, out_i):
-    """Points within sqrt(r2) of ``query`` into out_s/out_i (grown as needed); returns (count, out_s, out_i)."""
-    stack = np.empty(128, dtype=np.int64)
+def _radius_walk(order, start, stop, axis, split, left, right, points, query, r2, stack, out_s, out_i):
+    """Points within sqrt(r2) of ``query`` into out_s/out_i (grown as needed); returns (count, out_s, out_i).
+
+    ``stack`` holds ``stack_size`` entries. The output grows before a leaf is
+    read, never inside its loop, and every point is written, kept or not:
+    both keep the loop over a leaf's points free of branches and reloads.
+    """
     stack[0] = 0
     top = 1
     count = 0
@@ -192,20 +186,20 @@ def _radius_walk(order, start, stop, axis, split, left, right, points, query, r2
         node = stack[top]
         a = axis[node]
         if a < 0:
+            if count + stop[node] - start[node] > out_s.shape[0]:
+                grown = max(2 * out_s.shape[0], count + stop[node] - start[node])
+                new_s, new_i = np.empty(grown), np.empty(grown, dtype=np.int64)
+                new_s[:count], new_i[:count] = out_s[:count], out_i[:count]
+                out_s, out_i = new_s, new_i
             for position in range(start[node], stop[node]):
                 index = order[position]
-                s = _squared_distance(points, index, query)
-                if s <= r2:
-                    if count == out_s.shape[0]:
-                        out_s = np.concatenate((out_s, np.empty_like(out_s)))
-                        out_i = np.concatenate((out_i, np.empty_like(out_i)))
-                    out_s[count], out_i[count] = s, index
-                    count += 1
+                s = squared_distance(points, index, query)
+                out_s[count] = s
+                out_i[count] = index
+                count += s <= r2
             continue
         diff = query[a] - split[node]
         near, far = (left[node], right[node]) if diff <= 0 else (right[node], left[node])
-        if top + 2 > stack.shape[0]:
-            stack = np.concatenate((stack, np.empty_like(stack)))
         if diff * diff <= r2:
             stack[top] = far
             top += 1
@@ -215,34 +209,30 @@ def _radius_walk(order, start, stop, axis, split, left, right, points, query, r2
 
 
 @njit(cache=True, nogil=True)
-def sort_pairs(s, index):
-    """Order of the pairs (s, index) ascending, ties by index."""
-    by_index = np.argsort(index)
-    return by_index[np.argsort(s[by_index], kind="mergesort")]
-
-
-@njit(cache=True, nogil=True)
-def radius_rows(order, start, stop, axis, split, left, right, points, queries, r2, first, last):
+def radius_rows(order, start, stop, axis, split, left, right, stack_size, points, queries, r2, first, last):
     """CSR rows of ``queries[first:last]`` in one pass: (counts, indices, distances), each row sorted."""
     counts = np.zeros(last - first, dtype=np.int64)
     all_i = np.empty(max(64, 16 * (last - first)), dtype=np.int64)
     all_d = np.empty(all_i.shape[0])
     out_s = np.empty(64)
     out_i = np.empty(64, dtype=np.int64)
+    stack = np.empty(stack_size, dtype=np.int64)
     filled = 0
     for qi in range(first, last):
         c, out_s, out_i = _radius_walk(
-            order, start, stop, axis, split, left, right, points, queries[qi], r2, out_s, out_i
+            order, start, stop, axis, split, left, right, points, queries[qi], r2, stack, out_s, out_i
         )
-        if filled + c > all_i.shape[0]:
-            size = max(2 * all_i.shape[0], filled + c)
-            grown_i, grown_d = np.empty(size, dtype=np.int64), np.empty(size)
-            grown_i[:filled], grown_d[:filled] = all_i[:filled], all_d[:filled]
-            all_i, all_d = grown_i, grown_d
-        rank = sort_pairs(out_s[:c], out_i[:c])
-        for j in range(c):
-            all_i[filled + j] = out_i[rank[j]]
-            all_d[filled + j] = np.sqrt(out_s[rank[j]])
-        filled += c
+        all_i, all_d, filled = append_row(all_i, all_d, filled, out_s, out_i, c)
         counts[qi - first] = c
     return counts, all_i[:filled], all_d[:filled]
+
+
+@njit(cache=True, nogil=True)
+def stack_size(left, right):
+    """Entries a depth-first search's stack needs: one pending far child per level, plus two."""
+    depth = np.zeros(left.shape[0], dtype=np.int64)
+    for node in range(left.shape[0]):  # children have larger ids (checked before any search)
+        for child in (left[node], right[node]):
+            if child >= 0:
+                depth[child] = depth[node] + 1
+    return depth.max() + 2

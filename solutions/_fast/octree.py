@@ -9,9 +9,10 @@ visiting its subtree, and no node stores a list of points.
 import numpy as np
 from numba import njit
 
-from solutions._fast.kdtree import offer, sort_pairs
+from solutions._fast.kdtree import offer
+from solutions._fast.rows import append_row, squared_distance
 
-__all__ = ["build", "radius_rows", "knn"]
+__all__ = ["build", "radius_rows", "knn", "stack_size"]
 
 
 @njit(cache=True, nogil=True)
@@ -130,19 +131,13 @@ def _cube_reach(query, center, extent, node):
     return s
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _squared_distance(xyz, index, query):
-    s = 0.0
-    for j in range(3):
-        d = xyz[index, j] - query[j]
-        s += d * d
-    return s
-
-
 @njit(cache=True, nogil=True)
-def _radius_walk(order, start, stop, center, extent, children, xyz, query, r2, out_s, out_i):
-    """Points within sqrt(r2) of ``query`` into out_s/out_i (grown as needed); returns (count, out_s, out_i)."""
-    stack = np.empty(256, dtype=np.int64)
+def _radius_walk(order, start, stop, center, extent, children, xyz, query, r2, stack, out_s, out_i):
+    """Points within sqrt(r2) of ``query`` into out_s/out_i (grown as needed); returns (count, out_s, out_i).
+
+    ``stack`` holds ``stack_size`` entries, so it never grows (a reassigned
+    array slows every access); every point of a leaf is written, kept or not.
+    """
     stack[0] = 0
     top = 1
     count = 0
@@ -163,13 +158,11 @@ def _radius_walk(order, start, stop, center, extent, children, xyz, query, r2, o
                 out_s, out_i = new_s, new_i
             for position in range(start[node], stop[node]):
                 index = order[position]
-                s = _squared_distance(xyz, index, query)
-                if contained or s <= r2:
-                    out_s[count], out_i[count] = s, index
-                    count += 1
+                s = squared_distance(xyz, index, query)
+                out_s[count] = s
+                out_i[count] = index
+                count += contained or s <= r2
             continue
-        if top + 8 > stack.shape[0]:
-            stack = np.concatenate((stack, np.empty_like(stack)))
         for c in range(7, -1, -1):  # popped in code order
             child = children[node, c]
             if child >= 0 and _cube_gap(query, center, extent, child) <= r2:
@@ -179,34 +172,28 @@ def _radius_walk(order, start, stop, center, extent, children, xyz, query, r2, o
 
 
 @njit(cache=True, nogil=True)
-def radius_rows(order, start, stop, center, extent, children, xyz, queries, r2, first, last):
+def radius_rows(order, start, stop, center, extent, children, stack_size, xyz, queries, r2, first, last):
     """CSR rows of ``queries[first:last]`` in one pass: (counts, indices, distances), each row sorted."""
     counts = np.zeros(last - first, dtype=np.int64)
     all_i = np.empty(max(64, 16 * (last - first)), dtype=np.int64)
     all_d = np.empty(all_i.shape[0])
     out_s = np.empty(64)
     out_i = np.empty(64, dtype=np.int64)
+    stack = np.empty(stack_size, dtype=np.int64)
     filled = 0
     for qi in range(first, last):
-        c, out_s, out_i = _radius_walk(order, start, stop, center, extent, children, xyz, queries[qi], r2, out_s, out_i)
-        if filled + c > all_i.shape[0]:
-            size = max(2 * all_i.shape[0], filled + c)
-            grown_i, grown_d = np.empty(size, dtype=np.int64), np.empty(size)
-            grown_i[:filled], grown_d[:filled] = all_i[:filled], all_d[:filled]
-            all_i, all_d = grown_i, grown_d
-        rank = sort_pairs(out_s[:c], out_i[:c])
-        for j in range(c):
-            all_i[filled + j] = out_i[rank[j]]
-            all_d[filled + j] = np.sqrt(out_s[rank[j]])
-        filled += c
+        c, out_s, out_i = _radius_walk(
+            order, start, stop, center, extent, children, xyz, queries[qi], r2, stack, out_s, out_i
+        )
+        all_i, all_d, filled = append_row(all_i, all_d, filled, out_s, out_i, c)
         counts[qi - first] = c
     return counts, all_i[:filled], all_d[:filled]
 
 
 @njit(cache=True, nogil=True)
-def knn(order, start, stop, center, extent, children, xyz, queries, k, first, last, indices, distances):
+def knn(order, start, stop, center, extent, children, stack_size, xyz, queries, k, first, last, indices, distances):
     """k nearest neighbours with the contract's child order and early termination."""
-    capacity = 64
+    capacity = stack_size  # one frame per level: never grown
     frame_node = np.empty(capacity, dtype=np.int64)
     frame_next = np.empty(capacity, dtype=np.int64)  # -1: not entered yet
     frame_code = np.empty(capacity, dtype=np.int64)
@@ -229,7 +216,7 @@ def knn(order, start, stop, center, extent, children, xyz, queries, k, first, la
                 if leaf:
                     for p in range(start[node], stop[node]):
                         index = order[p]
-                        count = offer(_squared_distance(xyz, index, query), index, held_s, held_i, count, k)
+                        count = offer(squared_distance(xyz, index, query), index, held_s, held_i, count, k)
                     if count == k:
                         worst = held_s[k - 1]
                     position = 8  # processed
@@ -251,11 +238,6 @@ def knn(order, start, stop, center, extent, children, xyz, queries, k, first, la
                 child = children[node, c]
                 if child >= 0 and _cube_gap(query, center, extent, child) <= worst:
                     frame_next[depth] = position
-                    if depth + 1 == capacity:
-                        capacity *= 2
-                        frame_node = np.concatenate((frame_node, np.empty_like(frame_node)))
-                        frame_next = np.concatenate((frame_next, np.empty_like(frame_next)))
-                        frame_code = np.concatenate((frame_code, np.empty_like(frame_code)))
                     depth += 1
                     frame_node[depth], frame_next[depth] = child, -1
                     entered = True
@@ -274,3 +256,14 @@ def knn(order, start, stop, center, extent, children, xyz, queries, k, first, la
         for j in range(k):
             indices[qi, j] = held_i[j]
             distances[qi, j] = np.sqrt(held_s[j])
+
+
+@njit(cache=True, nogil=True)
+def stack_size(children):
+    """Entries a depth-first search's stack needs: up to eight children pushed per level."""
+    depth = np.zeros(children.shape[0], dtype=np.int64)
+    for node in range(children.shape[0]):  # children have larger ids (checked before any search)
+        for c in range(8):
+            if children[node, c] >= 0:
+                depth[children[node, c]] = depth[node] + 1
+    return 8 * (depth.max() + 1) + 1

@@ -1,0 +1,83 @@
+"""Pieces shared by the trees' searches (numba): distances, sorted rows, CSR output.
+
+A radius search finds a query's points in tree order; the contract wants each
+row ascending by (squared distance, index). Rows are short for the radii of
+point-cloud work, and an insertion sort in place beats an argsort with its
+allocations there. Long rows (a large radius) are argsorted by distance,
+then each run of equal distances is sorted by index.
+"""
+
+import numpy as np
+from numba import njit
+
+__all__ = ["squared_distance", "sort_row", "append_row", "unpermute_rows"]
+
+_INSERTION_LIMIT = 48
+
+
+@njit(cache=True, nogil=True, inline="always")
+def squared_distance(points, index, query):
+    """Squared distance from ``points[index]`` to ``query`` (the query's columns only)."""
+    s = 0.0
+    for j in range(query.shape[0]):
+        d = points[index, j] - query[j]
+        s += d * d
+    return s
+
+
+@njit(cache=True, nogil=True)
+def sort_row(s, index, count):
+    """Sort ``s[:count]`` and ``index[:count]`` in place, ascending by (s, index)."""
+    if count > _INSERTION_LIMIT:
+        rank = np.argsort(s[:count])  # by distance only; then the rare runs of equal distances by index
+        s[:count], index[:count] = s[:count][rank], index[:count][rank]
+        first = 0
+        while first < count:
+            end = first + 1
+            while end < count and s[end] == s[first]:
+                end += 1
+            if end - first > 1:
+                index[first:end] = np.sort(index[first:end])
+            first = end
+        return
+    for j in range(1, count):
+        sj, ij = s[j], index[j]
+        position = j
+        while position > 0 and (s[position - 1] > sj or (s[position - 1] == sj and index[position - 1] > ij)):
+            s[position] = s[position - 1]
+            index[position] = index[position - 1]
+            position -= 1
+        s[position] = sj
+        index[position] = ij
+
+
+@njit(cache=True, nogil=True)
+def append_row(all_i, all_d, filled, s, index, count):
+    """Sort one row and append it to the CSR arrays (grown as needed); returns (all_i, all_d, filled)."""
+    if filled + count > all_i.shape[0]:
+        size = max(2 * all_i.shape[0], filled + count)
+        grown_i, grown_d = np.empty(size, dtype=np.int64), np.empty(size)
+        grown_i[:filled], grown_d[:filled] = all_i[:filled], all_d[:filled]
+        all_i, all_d = grown_i, grown_d
+    sort_row(s, index, count)
+    for j in range(count):
+        all_i[filled + j] = index[j]
+        all_d[filled + j] = np.sqrt(s[j])
+    return all_i, all_d, filled + count
+
+
+@njit(cache=True, nogil=True)
+def unpermute_rows(indptr, indices, distances, permutation):
+    """CSR rows computed for ``queries[permutation]``, put back in the queries' order."""
+    counts = indptr[1:] - indptr[:-1]
+    final_counts = np.empty_like(counts)
+    final_counts[permutation] = counts
+    final_indptr = np.zeros(len(counts) + 1, dtype=np.int64)
+    final_indptr[1:] = np.cumsum(final_counts)
+    final_indices, final_distances = np.empty_like(indices), np.empty_like(distances)
+    for row in range(len(counts)):
+        source, target = indptr[row], final_indptr[permutation[row]]
+        for j in range(counts[row]):
+            final_indices[target + j] = indices[source + j]
+            final_distances[target + j] = distances[source + j]
+    return final_indptr, final_indices, final_distances
