@@ -98,7 +98,44 @@ def _cloud_and_queries(points, queries, min_columns):
 def kdtree_build(points, leaf_size=16):
     points = np.ascontiguousarray(as_points(points, min_columns=1))
     leaf_size = check_integer(leaf_size, "leaf_size", low=1)
-    return dict(zip(_KDTREE_KEYS, _kdtree.build(points, leaf_size)))
+    return _kdtree_in_threads(points, leaf_size)
+
+
+_PARALLEL_BUILD_POINTS = 50_000
+
+
+def _kdtree_in_threads(points, leaf_size):
+    """The contract's tree, its top levels split here and the subtrees below built on every core.
+
+    A subtree's node count depends on its size only (``node_count``), so
+    every subtree's preorder ids are known before it is built.
+    """
+    n = len(points)
+    nodes = _kdtree.node_count(n, leaf_size)
+    order = np.arange(n)
+    start, stop = np.empty(nodes, dtype=np.int64), np.empty(nodes, dtype=np.int64)
+    axis, split = np.full(nodes, -1, dtype=np.int64), np.full(nodes, np.nan)
+    left, right = np.full(nodes, -1, dtype=np.int64), np.full(nodes, -1, dtype=np.int64)
+    arrays = (order, start, stop, axis, split, left, right)
+    cores = os.cpu_count() or 1
+    subtrees, pending = [], [(0, n, 0, 0)]  # (lo, hi, depth, node id)
+    while pending:
+        lo, hi, depth, node = pending.pop()
+        if n < _PARALLEL_BUILD_POINTS or hi - lo <= leaf_size or len(subtrees) + len(pending) >= 4 * cores - 1:
+            subtrees.append((lo, hi, depth, node))
+            continue
+        start[node], stop[node], axis[node] = lo, hi, depth % points.shape[1]
+        m, split[node] = _kdtree.split_node(points, order, lo, hi, axis[node])
+        left[node], right[node] = node + 1, node + 1 + _kdtree.node_count(m - lo, leaf_size)
+        pending += [(m, hi, depth + 1, right[node]), (lo, m, depth + 1, left[node])]
+    if len(subtrees) == 1:
+        _kdtree.build_range(points, leaf_size, *arrays, *subtrees[0])
+    else:
+        with ThreadPoolExecutor(cores) as pool:
+            jobs = [pool.submit(_kdtree.build_range, points, leaf_size, *arrays, *subtree) for subtree in subtrees]
+            for job in jobs:
+                job.result()
+    return dict(zip(_KDTREE_KEYS, arrays))
 
 
 def _kdtree_arrays(tree, points):

@@ -4,9 +4,11 @@ The layout is the contract's (``pcl_course/nn.py``): one ``order`` array and
 per-node ``start/stop/axis/split/left/right``. The build selects each median
 in linear time (a quickselect on (coordinate, index) pairs, which are all
 distinct), so it costs O(N log N) and not the O(N log^2 N) of a sort per
-node. The searches keep the k best as a sorted array, which for the k of
-point-cloud work (8 to 32) beats a heap: most offers are rejected by one
-comparison with the last entry.
+node. Below its top levels the tree is built one subtree per thread
+(``build_range``): a subtree's node count depends only on its size, so its
+preorder ids are known in advance. The searches keep the k best as a
+sorted array, which for the k of point-cloud work (8 to 32) beats a heap:
+most offers are rejected by one comparison with the last entry.
 """
 
 import numpy as np
@@ -14,7 +16,7 @@ from numba import njit
 
 from solutions._fast.rows import append_row, squared_distance
 
-__all__ = ["build", "knn", "radius_rows", "offer", "stack_size"]
+__all__ = ["node_count", "split_node", "build_range", "knn", "radius_rows", "offer", "stack_size"]
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -63,55 +65,75 @@ def _select(keys, ids, nth):
         _swap(keys, ids, lo, lo + 1)
 
 
+def node_count(n, leaf_size):
+    """Nodes of the contract's tree on ``n`` points: fixed by ``n`` alone, so subtrees can be numbered apart."""
+    if n <= leaf_size:
+        return 1
+    # The sizes at one depth take at most two values, ceil and floor of the same quotient.
+    total, sizes = 0, {n: 1}
+    while sizes:
+        below = {}
+        for size, copies in sizes.items():
+            total += copies
+            if size > leaf_size:
+                for half in ((size + 1) // 2, size // 2):
+                    below[half] = below.get(half, 0) + copies
+        sizes = below
+    return total
+
+
 @njit(cache=True, nogil=True)
-def build(points, leaf_size):
-    """The contract's k-d tree of ``points`` (N, D): (order, start, stop, axis, split, left, right)."""
-    n, dim = points.shape
-    capacity = 2 * max(n, 1) + 1
-    start = np.empty(capacity, dtype=np.int64)
-    stop = np.empty(capacity, dtype=np.int64)
-    axis = np.full(capacity, -1, dtype=np.int64)
-    split = np.full(capacity, np.nan)
-    left = np.full(capacity, -1, dtype=np.int64)
-    right = np.full(capacity, -1, dtype=np.int64)
-    order = np.arange(n)
+def split_node(points, order, lo, hi, a):
+    """Put the first ceil(n / 2) of ``order[lo:hi]`` by (coordinate a, index) first; returns (m, split)."""
+    size = hi - lo
+    m = lo + (size + 1) // 2
+    ids = order[lo:hi]  # a view: selected in place
+    keys = np.empty(size)
+    for i in range(size):
+        keys[i] = points[ids[i], a]
+    _select(keys, ids, m - lo)
+    below = keys[0]
+    for i in range(1, m - lo):
+        below = max(below, keys[i])
+    above = keys[m - lo]
+    for i in range(m - lo + 1, size):
+        above = min(above, keys[i])
+    return m, (below + above) / 2
+
+
+@njit(cache=True, nogil=True)
+def build_range(points, leaf_size, order, start, stop, axis, split, left, right, lo, hi, depth, first_node):
+    """Build the subtree of ``order[lo:hi]`` at ``depth`` into the node arrays, numbered from ``first_node``.
+
+    Subtrees of disjoint ranges write disjoint entries: threads may build them at once.
+    Returns the number of nodes written.
+    """
+    dim = points.shape[1]
     # Pending nodes: (lo, hi, depth, parent); a parent >= 0 is waiting for its right child's id.
-    pending = np.empty((capacity, 4), dtype=np.int64)
-    pending[0] = (0, n, 0, -1)
+    # Depth first: one pending right child per level, and the median rule's depth is below 64.
+    pending = np.empty((130, 4), dtype=np.int64)
+    pending[0] = (lo, hi, depth, -1)
     top = 1
-    count = 0
+    node = first_node
     while top > 0:
         top -= 1
         lo, hi, depth, parent = pending[top]
-        node = count
-        count += 1
         if parent >= 0:
             right[parent] = node
         start[node], stop[node] = lo, hi
-        size = hi - lo
-        if size <= leaf_size:
+        if hi - lo <= leaf_size:
             order[lo:hi] = np.sort(order[lo:hi])
+            node += 1
             continue
         a = depth % dim
-        m = lo + (size + 1) // 2
-        ids = order[lo:hi]  # a view: selected in place
-        keys = np.empty(size)
-        for i in range(size):
-            keys[i] = points[ids[i], a]
-        _select(keys, ids, m - lo)
-        below = keys[0]
-        for i in range(1, m - lo):
-            below = max(below, keys[i])
-        above = keys[m - lo]
-        for i in range(m - lo + 1, size):
-            above = min(above, keys[i])
+        m, split[node] = split_node(points, order, lo, hi, a)
         axis[node] = a
-        split[node] = (below + above) / 2
-        left[node] = count  # preorder: the left child comes next
+        left[node] = node + 1  # preorder: the left child comes next
         pending[top] = (m, hi, depth + 1, node)
         pending[top + 1] = (lo, m, depth + 1, -1)
         top += 2
-    return order, start[:count], stop[:count], axis[:count], split[:count], left[:count], right[:count]
+        node += 1
+    return node - first_node
 
 
 @njit(cache=True, nogil=True, inline="always")

@@ -77,3 +77,26 @@ def test_scipy_trees_in_the_course_layout_are_valid_trees_that_search_right(name
     expected = trees.kdtree_search(nn.kdtree_build(points, 8), points, queries, k=5)
     got = nn.kdtree_knn(tree, points, queries, 5)
     assert np.array_equal(expected[0], got[0]) and np.allclose(expected[1], got[1])
+
+
+@pytest.mark.parametrize("leaf_size", [1, 3, 16])
+def test_the_threaded_build_numbers_its_subtrees_as_one_preorder(leaf_size, rng, monkeypatch):
+    """The reference splits its top levels, then builds subtrees in threads with precomputed ids."""
+    monkeypatch.setattr(nn, "_PARALLEL_BUILD_POINTS", 0)  # thread even a small cloud
+    for points in (rng.uniform(size=(1_001, 3)), np.repeat(rng.uniform(size=(90, 2)), 11, axis=0)):
+        expected, got = trees.kdtree(points, leaf_size), nn.kdtree_build(points, leaf_size)
+        assert all(np.array_equal(expected[k], got[k], equal_nan=True) for k in expected)
+
+
+def test_the_threaded_build_equals_one_serial_pass_on_a_large_cloud(rng):
+    from solutions._fast import kdtree as kernels
+
+    points = rng.uniform(size=(120_000, 3))
+    threaded = nn.kdtree_build(points, 16)
+    nodes = kernels.node_count(len(points), 16)
+    arrays = (np.arange(len(points)), *(np.empty(nodes, dtype=np.int64) for _ in range(2)),
+              np.full(nodes, -1, dtype=np.int64), np.full(nodes, np.nan),
+              *(np.full(nodes, -1, dtype=np.int64) for _ in range(2)))  # fmt: skip
+    assert kernels.build_range(points, 16, *arrays, 0, len(points), 0, 0) == nodes
+    serial = dict(zip(("order", "start", "stop", "axis", "split", "left", "right"), arrays))
+    assert all(np.array_equal(threaded[k], serial[k], equal_nan=True) for k in serial)
