@@ -25,15 +25,23 @@ $(CODE_STAMP): $(wildcard pcl_course/*.py solutions/*.py)
 	rm -rf _build/.jupyter_cache _build/.doctrees
 	mkdir -p _build && touch $@
 
+# numba's on-disk cache checks a kernel's own file only: a kernel that calls
+# one from another file of solutions/_fast (rows.py, say) would keep the old
+# code after that file changed. Any change there drops the whole cache.
+NUMBA_STAMP := _build/.numba-stamp
+$(NUMBA_STAMP): $(wildcard solutions/_fast/*.py)
+	rm -f solutions/_fast/__pycache__/*.nbi solutions/_fast/__pycache__/*.nbc
+	mkdir -p _build && touch $@
+
 # -W -n --keep-going: a failing cell (raise_on_error in _config.yml) or a
 # broken reference fails the build, and every problem is reported at once.
-book: setup $(CODE_STAMP)
+book: setup $(CODE_STAMP) $(NUMBA_STAMP)
 	$(BIN)/jupyter-book build . -W -n --keep-going
 	@echo "The book is in _build/html: open $(CURDIR)/_build/html/index.html"
 
 # The chapters as .ipynb (jupytext), for nbval: it runs every cell again,
 # independently of the book's execution cache.
-notebooks: setup
+notebooks: setup $(NUMBA_STAMP)
 	rm -rf _build/notebooks && mkdir -p _build/notebooks
 	for page in $$(grep -l '{code-cell}' book/*.md); do \
 	    $(BIN)/jupytext --quiet --to ipynb --output _build/notebooks/$$(basename $$page .md).ipynb $$page || exit 1; \
@@ -52,7 +60,7 @@ test: lint book notebooks
 test-images: setup
 	$(BIN)/python -m pytest tests/images -p no:xdist -p no:cacheprovider -o timeout=3600 -v -s
 
-grade: setup
+grade: setup $(NUMBA_STAMP)
 	@test -n "$(SUBMISSION)" || { echo "usage: make grade SUBMISSION=path/to/student/clone"; exit 2; }
 	$(BIN)/python -m grading grade "$(SUBMISSION)" --results "$(RESULTS)"
 
@@ -70,7 +78,7 @@ gradescope: setup
 # BENCH_MERGE=1 keeps the committed results of the cases a partial run did not measure.
 BENCH_ARGS ?=
 BENCH_OUT  ?= benchmarks/results
-bench: setup
+bench: setup $(NUMBA_STAMP)
 	mkdir -p _build/bench
 	$(BIN)/python -m pytest benchmarks -p no:xdist -p no:dash -p no:cacheprovider -o addopts= -o timeout=0 \
 	    -q --benchmark-json=_build/bench/raw.json --benchmark-save-data --benchmark-columns=median,iqr,rounds \
