@@ -84,8 +84,14 @@ def bst(keys):
     return left, right
 
 
-def kdtree(points, leaf_size):
-    """The contract's k-d tree (median rule, round-robin axes, preorder) as its dict."""
+def kdtree(points, leaf_size, median="ceil", split="mean", axis_rule="depth", partition="rank"):
+    """The contract's k-d tree (median rule, round-robin axes, preorder) as its dict.
+
+    The other values give known wrong builds: ``median="floor"`` (n // 2 points
+    left), ``split="point"`` (the split at the m-th coordinate),
+    ``axis_rule="spread"`` (the axis of largest spread), ``partition="value"``
+    (points below the split left, a leaf where a side would be empty).
+    """
     points = np.asarray(points, dtype=float)
     n, dim = points.shape
     nodes = []  # [start, stop, axis, split, left, right]
@@ -96,14 +102,22 @@ def kdtree(points, leaf_size):
         nodes.append([len(order), None, -1, math.nan, -1, -1])
         if len(indices) <= leaf_size:
             order.extend(sorted(indices))
+            nodes[node][1] = len(order)
+            return node
+        axis = int(np.argmax(np.ptp(points[indices], axis=0))) if axis_rule == "spread" else depth % dim
+        ranked = sorted(indices, key=lambda i: (points[i, axis], i))
+        m = (len(ranked) + 1) // 2 if median == "ceil" else len(ranked) // 2
+        at = (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2 if split == "mean" else points[ranked[m], axis]
+        lower, upper = ranked[:m], ranked[m:]
+        if partition == "value":  # by comparing with the split: ties all go right
+            lower = [i for i in ranked if points[i, axis] < at]
+            upper = [i for i in ranked if points[i, axis] >= at]
+        if not lower or not upper:  # only a wrong partition gets here: the student's guard makes a leaf
+            order.extend(sorted(indices))
         else:
-            axis = depth % dim
-            ranked = sorted(indices, key=lambda i: (points[i, axis], i))
-            m = (len(ranked) + 1) // 2
-            nodes[node][2] = axis
-            nodes[node][3] = (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2
-            nodes[node][4] = grow(ranked[:m], depth + 1)
-            nodes[node][5] = grow(ranked[m:], depth + 1)
+            nodes[node][2:4] = [axis, at]
+            nodes[node][4] = grow(lower, depth + 1)
+            nodes[node][5] = grow(upper, depth + 1)
         nodes[node][1] = len(order)
         return node
 

@@ -125,7 +125,7 @@ def _kdtree_in_threads(points, leaf_size):
             subtrees.append((lo, hi, depth, node))
             continue
         start[node], stop[node], axis[node] = lo, hi, depth % points.shape[1]
-        m, split[node] = _kdtree.split_node(points, order, lo, hi, axis[node])
+        m, split[node] = _kdtree.split_node(points, order, lo, hi, axis[node], np.empty(hi - lo))
         left[node], right[node] = node + 1, node + 1 + _kdtree.node_count(m - lo, leaf_size)
         pending += [(m, hi, depth + 1, right[node]), (lo, m, depth + 1, left[node])]
     if len(subtrees) == 1:

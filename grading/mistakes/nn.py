@@ -173,54 +173,11 @@ BST_KNN = Model(
 # -- k-d tree -------------------------------------------------------------------------------------
 
 
-def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="depth", partition="rank"):
+def kdtree_build(points, leaf_size=16, **changes):
     points = valid_points(points)
     if not isinstance(leaf_size, (int, np.integer)) or leaf_size < 1:
         raise ValueError("leaf_size")
-    if median == "ceil" and split == "mean" and axis_rule == "depth" and partition == "rank":
-        return trees.kdtree(points, int(leaf_size))
-    n, dim = points.shape
-    nodes, order = [], []
-
-    def grow(indices, depth):
-        node = len(nodes)
-        nodes.append([len(order), None, -1, math.nan, -1, -1])
-        if len(indices) <= leaf_size:
-            order.extend(sorted(indices))
-        else:
-            if axis_rule == "spread":
-                axis = int(np.argmax(np.ptp(points[indices], axis=0)))
-            else:
-                axis = depth % dim
-            ranked = sorted(indices, key=lambda i: (points[i, axis], i))
-            m = (len(ranked) + 1) // 2 if median == "ceil" else len(ranked) // 2
-            nodes[node][2] = axis
-            nodes[node][3] = (
-                (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2
-                if split == "mean"
-                else points[ranked[m], axis]
-            )
-            lower, upper = ranked[:m], ranked[m:]
-            if partition == "value":  # by comparing with the split: ties all go right
-                lower = [i for i in ranked if points[i, axis] < nodes[node][3]]
-                upper = [i for i in ranked if points[i, axis] >= nodes[node][3]]
-            if not lower or not upper:  # the student's guard against endless splitting: a leaf
-                nodes[node][2:4] = [-1, math.nan]
-                order.extend(sorted(indices))
-            else:
-                nodes[node][4] = grow(lower, depth + 1)
-                nodes[node][5] = grow(upper, depth + 1)
-        nodes[node][1] = len(order)
-        return node
-
-    grow(list(range(n)), 0)
-    table = list(zip(*nodes))
-    keys = ("start", "stop", "axis", "split", "left", "right")
-    tree = {"order": np.array(order, dtype=np.int64)}
-    tree.update(
-        {key: np.array(column, dtype=float if key == "split" else np.int64) for key, column in zip(keys, table)}
-    )
-    return tree
+    return trees.kdtree(points, int(leaf_size), **changes)
 
 
 KDTREE_BUILD = Model(

@@ -83,12 +83,15 @@ def node_count(n, leaf_size):
 
 
 @njit(cache=True, nogil=True)
-def split_node(points, order, lo, hi, a):
-    """Put the first ceil(n / 2) of ``order[lo:hi]`` by (coordinate a, index) first; returns (m, split)."""
+def split_node(points, order, lo, hi, a, scratch):
+    """Put the first ceil(n / 2) of ``order[lo:hi]`` by (coordinate a, index) first; returns (m, split).
+
+    ``scratch`` (at least hi - lo floats) holds the node's coordinates, so no node allocates.
+    """
     size = hi - lo
     m = lo + (size + 1) // 2
     ids = order[lo:hi]  # a view: selected in place
-    keys = np.empty(size)
+    keys = scratch[:size]
     for i in range(size):
         keys[i] = points[ids[i], a]
     _select(keys, ids, m - lo)
@@ -99,6 +102,21 @@ def split_node(points, order, lo, hi, a):
     for i in range(m - lo + 1, size):
         above = min(above, keys[i])
     return m, (below + above) / 2
+
+
+@njit(cache=True, nogil=True, inline="always")
+def _sort_in_place(values, lo, hi):
+    """Sort ``values[lo:hi]`` in place: insertion sort for a leaf's few entries, else NumPy's."""
+    if hi - lo > 64:
+        values[lo:hi] = np.sort(values[lo:hi])
+        return
+    for j in range(lo + 1, hi):
+        v = values[j]
+        position = j
+        while position > lo and values[position - 1] > v:
+            values[position] = values[position - 1]
+            position -= 1
+        values[position] = v
 
 
 @njit(cache=True, nogil=True)
@@ -112,6 +130,7 @@ def build_range(points, leaf_size, order, start, stop, axis, split, left, right,
     # Pending nodes: (lo, hi, depth, parent); a parent >= 0 is waiting for its right child's id.
     # Depth first: one pending right child per level, and the median rule's depth is below 64.
     pending = np.empty((130, 4), dtype=np.int64)
+    scratch = np.empty(hi - lo)
     pending[0] = (lo, hi, depth, -1)
     top = 1
     node = first_node
@@ -122,11 +141,11 @@ def build_range(points, leaf_size, order, start, stop, axis, split, left, right,
             right[parent] = node
         start[node], stop[node] = lo, hi
         if hi - lo <= leaf_size:
-            order[lo:hi] = np.sort(order[lo:hi])
+            _sort_in_place(order, lo, hi)
             node += 1
             continue
         a = depth % dim
-        m, split[node] = split_node(points, order, lo, hi, a)
+        m, split[node] = split_node(points, order, lo, hi, a, scratch)
         axis[node] = a
         left[node] = node + 1  # preorder: the left child comes next
         pending[top] = (m, hi, depth + 1, node)
