@@ -335,9 +335,9 @@ def nn_cases(sizes=SIZES, datasets=DATASETS):
     for dataset in (d for d in datasets if d in ("cube", "scan")):
         for n in sizes:
             cases += [_kdtree_build_case(dataset, n), _kdtree_knn_case(dataset, n, 8)]
-            cases += [_kdtree_knn_case(dataset, n, 32), _kdtree_radius_case(dataset, n)] if n <= 100_000 else []
+            cases += [_kdtree_knn_case(dataset, n, 32), _kdtree_radius_case(dataset, n)]
     if "scan" in datasets:
-        cases += [_octree_radius_case(n) for n in sizes if n <= 100_000]
+        cases += [_octree_radius_case(n) for n in sizes]
     return cases
 
 
