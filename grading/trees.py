@@ -473,13 +473,17 @@ def kdtree_search(
     return _knn_rows(results, k) if k is not None else _csr_rows(results)
 
 
-def octree_search(tree, points, queries, k=None, radius=None, contains=True, early=True, own_first=True, box=False):
+def octree_search(
+    tree, points, queries, k=None, radius=None, contains=True, early=True, own_first=True, box=False, strict=False
+):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
     The flags give known wrong versions: ``contains=False`` (descend into a
     contained octant), ``early=False`` (no early termination),
     ``own_first=False`` (children in plain code order), ``box`` (a cube
-    meets the ball if it meets the ball's bounding box: too weak).
+    meets the ball if it meets the ball's bounding box: too weak),
+    ``strict`` (a cube meets the ball only if its distance is below the
+    radius: the course scaffold's ``overlaps``, which loses points on a face).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -489,7 +493,7 @@ def octree_search(tree, points, queries, k=None, radius=None, contains=True, ear
         c, e = tree["center"][node], tree["extent"][node]
         if box:
             return bool(np.all(np.abs(query - c) <= e + math.sqrt(w2)))
-        return _gap2(query, c, e) <= w2
+        return _gap2(query, c, e) < w2 if strict else _gap2(query, c, e) <= w2
 
     for query in queries:
         best = _Best(k) if k is not None else None

@@ -377,6 +377,12 @@ OCTREE_RADIUS = Model(
     mistakes=(
         Mistake("reads_unreached", READS_UNREACHED, _brute_csr),
         Mistake(
+            "strict_overlap",
+            "a child's cube meets the ball when its squared distance to the query is <= r ** 2, inclusive: a point on "
+            "a centre plane belongs to the lower octant and can lie on its face at exactly r",
+            lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, strict=True),
+        ),
+        Mistake(
             "box_overlap",
             "a child's cube meets the ball iff sum_j max(|q_j - c_j| - e, 0) ** 2 <= r ** 2 (the distance to the "
             "cube); testing each axis alone (the ball's bounding box) is too weak and reads octants the rule skips",
@@ -410,6 +416,12 @@ OCTREE_KNN = Model(
             "code_order_only",
             "visit the child whose code the query has first, then the others in code order",
             lambda tree, points, queries, k: octree_knn(tree, points, queries, k, own_first=False),
+        ),
+        Mistake(
+            "strict_overlap",
+            "a child's cube meets the ball when its squared distance to the query is <= w2, inclusive: a point on "
+            "a centre plane belongs to the lower octant and can lie on its face at exactly the k-th distance",
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, strict=True),
         ),
     ),
 )
