@@ -84,13 +84,15 @@ def bst(keys):
     return left, right
 
 
-def kdtree(points, leaf_size, median="ceil", split="mean", axis_rule="depth", partition="rank"):
+def kdtree(points, leaf_size, median="ceil", split="mean", axis_rule="depth", partition="rank", ties="index"):
     """The contract's k-d tree (median rule, round-robin axes, preorder) as its dict.
 
     The other values give known wrong builds: ``median="floor"`` (n // 2 points
     left), ``split="point"`` (the split at the m-th coordinate),
     ``axis_rule="spread"`` (the axis of largest spread), ``partition="value"``
-    (points below the split left, a leaf where a side would be empty).
+    (points below the split left, a leaf where a side would be empty),
+    ``ties="argsort"`` (equal coordinates in whatever order NumPy's default
+    argsort leaves them, as the course's scaffold sorts, not by index).
     """
     points = np.asarray(points, dtype=float)
     n, dim = points.shape
@@ -105,7 +107,10 @@ def kdtree(points, leaf_size, median="ceil", split="mean", axis_rule="depth", pa
             nodes[node][1] = len(order)
             return node
         axis = int(np.argmax(np.ptp(points[indices], axis=0))) if axis_rule == "spread" else depth % dim
-        ranked = sorted(indices, key=lambda i: (points[i, axis], i))
+        if ties == "argsort":
+            ranked = [indices[j] for j in np.argsort(points[indices, axis])]
+        else:
+            ranked = sorted(indices, key=lambda i: (points[i, axis], i))
         m = (len(ranked) + 1) // 2 if median == "ceil" else len(ranked) // 2
         at = (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2 if split == "mean" else points[ranked[m], axis]
         lower, upper = ranked[:m], ranked[m:]

@@ -199,6 +199,12 @@ KDTREE_BUILD = Model(
             lambda points, leaf_size=16: kdtree_build(points, leaf_size, axis_rule="spread"),
         ),
         Mistake(
+            "argsort_ties",
+            "order a node's points by (coordinate, index): np.argsort of the coordinate alone leaves equal "
+            "coordinates in an arbitrary order (np.lexsort((indices, coordinate)) breaks the ties by index)",
+            lambda points, leaf_size=16: kdtree_build(points, leaf_size, ties="argsort"),
+        ),
+        Mistake(
             "value_split",
             "the left child takes the first m = ceil(n / 2) points of the order by (coordinate, index), not the "
             "points below the split: equal coordinates fall on both sides of it, or duplicates would never split",
