@@ -1,0 +1,171 @@
+"""Plain-Python trees and searches for the lecture-2 mutants, each mistake a flag.
+
+Written the way a student writes them (recursion, sorted lists), apart from
+the grader's own trees (``grading/trees.py``): a mutant and its diagnosis are
+two independent codings of one mistake, so the diagnosis check can fail. The
+mutants in the folders next to this file call these with one flag changed;
+their docstrings say what they get wrong. Trusted code: only the project's
+tests import it, in the grading process.
+"""
+
+import numpy as np
+
+__all__ = ["kdtree_build", "kdtree_knn", "kdtree_radius", "octree_knn", "octree_radius"]
+
+
+def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="depth", partition="rank", ties="index"):
+    """A k-d tree in the contract's layout; the keywords other than the defaults are mistakes."""
+    points = np.asarray(points, dtype=float)
+    nodes, order = [], []
+
+    def grow(indices, depth):
+        node = len(nodes)
+        nodes.append([len(order), 0, -1, np.nan, -1, -1])
+        if len(indices) <= leaf_size:
+            order.extend(sorted(indices))
+            nodes[node][1] = len(order)
+            return node
+        axis = int(np.argmax(np.ptp(points[indices], axis=0))) if axis_rule == "spread" else depth % points.shape[1]
+        if ties == "argsort":  # the course scaffold's sort: equal coordinates in the sort's own order
+            ranked = [indices[j] for j in np.argsort(points[indices, axis])]
+        else:
+            ranked = sorted(indices, key=lambda i: (points[i, axis], i))
+        m = (len(ranked) + 1) // 2 if median == "ceil" else len(ranked) // 2
+        at = (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2 if split == "mean" else points[ranked[m], axis]
+        lower, upper = ranked[:m], ranked[m:]
+        if partition == "value":
+            lower = [i for i in ranked if points[i, axis] < at]
+            upper = [i for i in ranked if points[i, axis] >= at]
+        if lower and upper:
+            nodes[node][2:4] = [axis, at]
+            nodes[node][4] = grow(lower, depth + 1)
+            nodes[node][5] = grow(upper, depth + 1)
+        else:  # a split that leaves a side empty: a leaf, the guard a student adds after an endless recursion
+            order.extend(sorted(indices))
+        nodes[node][1] = len(order)
+        return node
+
+    grow(list(range(len(points))), 0)
+    columns = [np.array(c) for c in zip(*nodes)]
+    tree = {"order": np.array(order, dtype=np.int64)}
+    for key, column in zip(("start", "stop", "axis", "split", "left", "right"), columns):
+        tree[key] = column.astype(np.float64 if key == "split" else np.int64)
+    return tree
+
+
+def _kd_search(tree, points, query, k, radius, far_first, prune, keep):
+    held = []  # (squared distance, index), sorted
+
+    def bound():
+        if k is None:
+            return radius**2
+        return held[-1][0] if len(held) == k else np.inf
+
+    def visit(node):
+        nonlocal held
+        if tree["axis"][node] < 0:
+            for index in tree["order"][tree["start"][node] : tree["stop"][node]]:
+                s = float(np.sum((points[index] - query) ** 2))
+                if k is not None:
+                    held = sorted([*held, (s, int(index))])[:k]
+                elif s < radius**2 or (keep == "<=" and s == radius**2):
+                    held.append((s, int(index)))
+            return
+        diff = query[tree["axis"][node]] - tree["split"][node]
+        near, far = tree["left"][node], tree["right"][node]
+        if (diff > 0) != far_first:  # the query's side first; with far_first, the other side
+            near, far = far, near
+        visit(near)
+        gap = abs(diff) if prune == "|d| <= w2" else diff * diff
+        if prune == "none" or gap < bound() or (prune != "<" and gap == bound()):
+            visit(far)
+
+    visit(0)
+    return sorted(held)
+
+
+def kdtree_knn(tree, points, queries, k, far_first=False, prune="<="):
+    """kNN rows of a plain depth-first search; ``prune`` is "<=", "<", "none" or "|d| <= w2"."""
+    points = np.asarray(points, dtype=float)
+    rows = [_kd_search(tree, points, q, k, None, far_first, prune, "<=") for q in np.asarray(queries, dtype=float)]
+    return _knn_arrays(rows, k)
+
+
+def kdtree_radius(tree, points, queries, radius, prune="<=", keep="<="):
+    """CSR rows of a plain depth-first search; ``keep`` "<" drops the points at exactly the radius."""
+    points = np.asarray(points, dtype=float)
+    rows = [_kd_search(tree, points, q, None, radius, False, prune, keep) for q in np.asarray(queries, dtype=float)]
+    return _csr_arrays(rows)
+
+
+def _octree_search(tree, xyz, query, k, radius, contains, early, own_first, box, strict):
+    held = []  # (squared distance, index), sorted
+
+    def bound():
+        if k is None:
+            return radius**2
+        return held[-1][0] if len(held) == k else np.inf
+
+    def offer(node, everything=False):
+        nonlocal held
+        for index in tree["order"][tree["start"][node] : tree["stop"][node]]:
+            s = float(np.sum((xyz[index] - query) ** 2))
+            if k is not None:
+                held = sorted([*held, (s, int(index))])[:k]
+            elif everything or s <= radius**2:
+                held.append((s, int(index)))
+
+    def meets(node):
+        gap = np.abs(query - tree["center"][node]) - tree["extent"][node]
+        if box:
+            return bool(np.all(gap <= np.sqrt(bound())))
+        distance2 = float(np.sum(np.maximum(gap, 0.0) ** 2))
+        return distance2 < bound() if strict else distance2 <= bound()
+
+    def visit(node):
+        center, extent = tree["center"][node], tree["extent"][node]
+        children = tree["children"][node]
+        if k is None and contains and np.sum((np.abs(query - center) + extent) ** 2) <= radius**2:
+            offer(node, everything=True)
+            return False
+        if np.all(children < 0):
+            offer(node)
+        else:
+            own = int(sum(1 << j for j in range(3) if query[j] > center[j]))
+            codes = [own] + [c for c in range(8) if c != own] if own_first else list(range(8))
+            for code in codes:
+                if children[code] >= 0 and meets(children[code]) and visit(children[code]):
+                    return True
+        return k is not None and early and bool(np.all(np.abs(query - center) + np.sqrt(bound()) < extent))
+
+    visit(0)
+    return sorted(held)
+
+
+def octree_knn(tree, points, queries, k, early=True, own_first=True, box=False, strict=False):
+    """kNN rows of a plain recursive octree search (Behley's order and early termination by default)."""
+    xyz = np.asarray(points, dtype=float)[:, :3]
+    flags = (True, early, own_first, box, strict)
+    rows = [_octree_search(tree, xyz, q[:3], k, None, *flags) for q in np.asarray(queries, dtype=float)]
+    return _knn_arrays(rows, k)
+
+
+def octree_radius(tree, points, queries, radius, contains=True, box=False, strict=False):
+    """CSR rows of a plain recursive octree search (with the contains shortcut by default)."""
+    xyz = np.asarray(points, dtype=float)[:, :3]
+    flags = (contains, False, True, box, strict)
+    rows = [_octree_search(tree, xyz, q[:3], None, radius, *flags) for q in np.asarray(queries, dtype=float)]
+    return _csr_arrays(rows)
+
+
+def _knn_arrays(rows, k):
+    indices = np.array([[i for _, i in row] for row in rows], dtype=np.int64).reshape(len(rows), k)
+    distances = np.sqrt(np.array([[s for s, _ in row] for row in rows], dtype=float).reshape(len(rows), k))
+    return indices, distances
+
+
+def _csr_arrays(rows):
+    indptr = np.concatenate([[0], np.cumsum([len(row) for row in rows])]).astype(np.int64)
+    indices = np.array([i for row in rows for _, i in row], dtype=np.int64)
+    distances = np.sqrt(np.array([s for row in rows for s, _ in row], dtype=float))
+    return indptr, indices, distances
