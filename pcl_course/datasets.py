@@ -946,7 +946,14 @@ def render_street_view(seed=0, max_depth=80.0, camera=None):
 # --- published results the book cites ---------------------------------------------
 
 
-_PUBLISHED = Path(__file__).parent / "data"
+# Two kinds of table, kept apart so that each can be checked for what it is:
+# published/ holds byte copies of the lecture's published figures (the course's shared data),
+# compiled/ holds tables this course compiled itself, each citing its public source and commit.
+_TABLE_DIRS = tuple(Path(__file__).parent / "data" / kind for kind in ("published", "compiled"))
+
+
+def _table_paths():
+    return {path.stem: path for directory in _TABLE_DIRS for path in sorted(directory.glob("*.csv"))}
 
 
 def published_table(name):
@@ -955,10 +962,12 @@ def published_table(name):
     Parameters
     ----------
     name : str
-        The file's name without ``.csv`` in ``pcl_course/data/``, e.g.
-        ``"snet_modelnet40_classification"`` (Dovrat et al., "Learning to
-        Sample", CVPR 2019: PointNet's accuracy on ModelNet40 when each test
-        cloud is reduced by random sampling, FPS or S-NET).
+        The file's name without ``.csv``, in ``pcl_course/data/published/``
+        (copies of figures published with the lecture's papers) or
+        ``pcl_course/data/compiled/`` (tables this course compiled from public
+        sources). For example ``"snet_modelnet40_classification"`` (Dovrat et
+        al., "Learning to Sample", CVPR 2019: PointNet's accuracy on ModelNet40
+        when each test cloud is reduced by random sampling, FPS or S-NET).
 
     Returns
     -------
@@ -967,10 +976,10 @@ def published_table(name):
     source : str
         The file's leading ``#`` comment lines: what the numbers are, and where they were published.
     """
-    path = _PUBLISHED / f"{name}.csv"
-    if not path.is_file():
-        known = sorted(p.stem for p in _PUBLISHED.glob("*.csv"))
-        raise ValueError(f"name must be one of {known}, got {name!r}")
+    paths = _table_paths()
+    if name not in paths:
+        raise ValueError(f"name must be one of {sorted(paths)}, got {name!r}")
+    path = paths[name]
     lines = path.read_text().splitlines()
     source = " ".join(line.lstrip("# ").strip() for line in lines if line.startswith("#"))
     rows = [line.split(",") for line in lines if line and not line.startswith("#")]

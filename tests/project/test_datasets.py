@@ -1,5 +1,7 @@
 """The generated data: shapes with exact normals, mini ModelNet, lidar scan, file formats."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -251,8 +253,37 @@ def test_published_table_reads_the_lecture_table_with_its_source():
 
 @pytest.mark.skipif(not SHARED_DATA.is_dir(), reason="../shared/data is not beside this clone")
 def test_published_tables_are_the_shared_files_unchanged():
-    for path in (REPO_ROOT / "pcl_course" / "data").glob("*.csv"):
-        assert path.read_bytes() == (SHARED_DATA / path.name).read_bytes(), f"{path.name} differs from ../shared/data"
+    published = sorted((REPO_ROOT / "pcl_course" / "data" / "published").glob("*.csv"))
+    assert published
+    for path in published:
+        shared = SHARED_DATA / path.name
+        assert shared.is_file(), f"{path.name} is in data/published/ but not in ../shared/data"
+        assert path.read_bytes() == shared.read_bytes(), f"{path.name} differs from ../shared/data"
+
+
+def test_every_table_is_in_one_of_the_two_kinds_and_names_are_unique():
+    data = REPO_ROOT / "pcl_course" / "data"
+    assert not list(data.glob("*.csv")), "a table goes into data/published/ or data/compiled/"
+    stems = [path.stem for path in data.glob("*/*.csv")]
+    assert {path.parent.name for path in data.glob("*/*.csv")} <= {"published", "compiled"}
+    assert len(stems) == len(set(stems))
+
+
+def test_a_compiled_table_cites_its_public_source_at_a_commit():
+    compiled = sorted((REPO_ROOT / "pcl_course" / "data" / "compiled").glob("*.csv"))
+    assert compiled
+    for path in compiled:
+        table, source = datasets.published_table(path.stem)
+        assert re.search(r"\b[\w.-]+/[\w.-]+\b", source), f"{path.name} names no repository"
+        assert re.search(r"commit [0-9a-f]{7,40}\b", source), f"{path.name} names no commit"
+        assert all(np.all(np.isfinite(column)) for column in table.values())
+
+
+def test_the_students_reports_read_with_their_columns():
+    table, source = datasets.published_table("kitti_nn_student_reports")
+    assert table["report"].tolist() == [1, 2]
+    assert {"kdtree_build", "kdtree_knn", "octree_knn", "brute"} <= set(table)
+    assert np.all(table["brute"] > table["kdtree_knn"])
 
 
 def test_published_table_rejects_an_unknown_name():
