@@ -7,9 +7,14 @@ student's own ``pcl_course`` code.
 """
 
 import importlib
+import time
 from pathlib import Path
 
-__all__ = ["implementation"]
+import numpy as np
+
+from pcl_course.validation import check_choice, check_integer
+
+__all__ = ["implementation", "wall_time"]
 
 # Where the reference solutions live in the instructors' repository; the
 # student release sets it to None (it ships no solutions).
@@ -27,6 +32,39 @@ def implementation(module):
                 raise
     _show_stubs_briefly()
     return importlib.import_module(f"pcl_course.{module}")
+
+
+_STATISTICS = {"min": np.min, "median": np.median}
+
+
+def wall_time(function, repeat=1, statistic="min"):
+    """Time ``function()`` on the wall clock, as the book's measured sentences quote it.
+
+    Parameters
+    ----------
+    function : callable
+        Called with no argument, ``repeat`` times.
+    repeat : int, default 1
+        How many runs to time (at least 1).
+    statistic : {"min", "median"}, default "min"
+        How the runs' times combine: the best run (least disturbed by the rest
+        of the machine) or the median one.
+
+    Returns
+    -------
+    seconds : float
+        The combined time, in seconds.
+    result : object
+        What the last run returned.
+    """
+    combine = _STATISTICS[check_choice(statistic, "statistic", tuple(_STATISTICS))]
+    repeat = check_integer(repeat, "repeat", low=1)
+    times = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        result = function()
+        times.append(time.perf_counter() - start)
+    return float(combine(times)), result
 
 
 def _show_stubs_briefly():

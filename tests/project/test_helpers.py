@@ -1,5 +1,7 @@
 """The complete helpers of pcl_course: validation, neighbour search, book picker."""
 
+import time
+
 import numpy as np
 import pytest
 from scipy.spatial.distance import cdist
@@ -129,3 +131,25 @@ def test_the_book_shows_a_bug_in_exercise_code_in_full_and_a_consequence_briefly
     with pytest.raises(ValueError) as in_a_helper:
         plotting.samples_top_view(np.zeros((4, 3)), {})  # no samples: what a failed stub leaves behind
     assert not book._raised_in_exercise_code(in_a_helper.tb)
+
+
+def test_wall_time_combines_the_runs_and_returns_the_last_result():
+    pauses = iter([0.03, 0.0, 0.0])
+    calls = []
+
+    def pause():
+        calls.append(None)
+        seconds = next(pauses)
+        end = time.perf_counter() + seconds
+        while time.perf_counter() < end:
+            pass
+        return len(calls)
+
+    best, result = book.wall_time(pause, repeat=3)
+    assert result == 3 and len(calls) == 3
+    assert best < 0.03  # the best run, not the first or the sum
+    median, _ = book.wall_time(lambda: time.sleep(0.002), repeat=3, statistic="median")
+    assert median >= 0.002
+    for bad in (dict(repeat=0), dict(repeat=1.5), dict(statistic="mean")):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            book.wall_time(lambda: None, **bad)
