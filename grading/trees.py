@@ -84,7 +84,9 @@ def bst(keys):
     return left, right
 
 
-def kdtree(points, leaf_size, median="ceil", split="mean", axis_rule="depth", partition="rank", ties="index"):
+def kdtree(
+    points, leaf_size, median="ceil", split="mean", axis_rule="depth", partition="rank", ties="index", guard=True
+):
     """The contract's k-d tree (median rule, round-robin axes, preorder) as its dict.
 
     The other values give known wrong builds: ``median="floor"`` (n // 2 points
@@ -93,13 +95,17 @@ def kdtree(points, leaf_size, median="ceil", split="mean", axis_rule="depth", pa
     (points below the split left, a leaf where a side would be empty),
     ``ties="argsort"`` (equal coordinates in whatever order NumPy's default
     argsort leaves them, as the course's scaffold sorts, not by index).
+    With ``guard=False`` a split that leaves a side empty makes an empty
+    child and recurses on the other with the same points at the next depth;
+    when that comes back to the same axis, the recursion never ends:
+    ``RecursionError``.
     """
     points = np.asarray(points, dtype=float)
     n, dim = points.shape
     nodes = []  # [start, stop, axis, split, left, right]
     order = []
 
-    def grow(indices, depth):
+    def grow(indices, depth, unsplit=0):
         node = len(nodes)
         nodes.append([len(order), None, -1, math.nan, -1, -1])
         if len(indices) <= leaf_size:
@@ -117,12 +123,15 @@ def kdtree(points, leaf_size, median="ceil", split="mean", axis_rule="depth", pa
         if partition == "value":  # by comparing with the split: ties all go right
             lower = [i for i in ranked if points[i, axis] < at]
             upper = [i for i in ranked if points[i, axis] >= at]
-        if not lower or not upper:  # only a wrong partition gets here: the student's guard makes a leaf
+        unsplit = unsplit + 1 if not lower or not upper else 0
+        if unsplit and guard:  # only a wrong partition gets here: the student's guard makes a leaf
             order.extend(sorted(indices))
+        elif unsplit == dim:  # the same points, back at the same axis: endless
+            raise RecursionError("a child holds all of its parent's points on every axis: the recursion never ends")
         else:
             nodes[node][2:4] = [axis, at]
-            nodes[node][4] = grow(lower, depth + 1)
-            nodes[node][5] = grow(upper, depth + 1)
+            nodes[node][4] = grow(lower, depth + 1, unsplit)
+            nodes[node][5] = grow(upper, depth + 1, unsplit)
         nodes[node][1] = len(order)
         return node
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from grading import trees
-from grading.mistakes import Mistake, Model, Raised, valid_points
+from grading.mistakes import Mistake, Model, Raised, Variants, valid_points
 from pcl_course.validation import check_bst, check_kdtree, check_octree
 
 READS_UNREACHED = (
@@ -180,6 +180,18 @@ def kdtree_build(points, leaf_size=16, **changes):
     return trees.kdtree(points, int(leaf_size), **changes)
 
 
+def _value_split(points, leaf_size=16):
+    """The build that splits by value, with the guard a student adds (a leaf where a side is empty)
+    or without it (an empty child, and the same points split again on the next axis, endlessly
+    where they agree on every axis)."""
+    guarded = kdtree_build(points, leaf_size, partition="value")
+    try:
+        unguarded = kdtree_build(points, leaf_size, partition="value", guard=False)
+    except RecursionError:
+        unguarded = Raised("RecursionError")
+    return Variants((guarded, unguarded))
+
+
 KDTREE_BUILD = Model(
     truth=kdtree_build,
     mistakes=(
@@ -208,7 +220,7 @@ KDTREE_BUILD = Model(
             "value_split",
             "the left child takes the first m = ceil(n / 2) points of the order by (coordinate, index), not the "
             "points below the split: equal coordinates fall on both sides of it, or duplicates would never split",
-            lambda points, leaf_size=16: kdtree_build(points, leaf_size, partition="value"),
+            _value_split,
         ),
     ),
 )

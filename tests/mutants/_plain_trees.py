@@ -33,10 +33,10 @@ def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="d
         m = (len(ranked) + 1) // 2 if median == "ceil" else len(ranked) // 2
         at = (points[ranked[m - 1], axis] + points[ranked[m], axis]) / 2 if split == "mean" else points[ranked[m], axis]
         lower, upper = ranked[:m], ranked[m:]
-        if partition == "value":
+        if partition.startswith("value"):
             lower = [i for i in ranked if points[i, axis] < at]
             upper = [i for i in ranked if points[i, axis] >= at]
-        if lower and upper:
+        if lower and upper or partition == "value, unguarded":
             nodes[node][2:4] = [axis, at]
             nodes[node][4] = grow(lower, depth + 1)
             nodes[node][5] = grow(upper, depth + 1)

@@ -94,3 +94,24 @@ def test_the_threaded_build_equals_the_graders_tree_on_a_large_cloud(rng):
     assert len(points) >= nn._PARALLEL_BUILD_POINTS
     threaded, expected = nn.kdtree_build(points, 16), trees.kdtree(points, 16)
     assert all(np.array_equal(threaded[k], expected[k], equal_nan=True) for k in expected)
+
+
+def test_the_unguarded_value_split_is_the_students_build_and_endless_only_on_points_equal_on_every_axis(rng):
+    from tests.mutants import _plain_trees
+
+    cloud = rng.uniform(size=(400, 3))
+    cloud[:, 0] = rng.integers(0, 3, size=400)  # equal x: empty sides, then a split on the next axis
+    grader = trees.kdtree(cloud, 4, partition="value", guard=False)
+    student = _plain_trees.kdtree_build(cloud, 4, partition="value, unguarded")
+    assert any(stop == start for start, stop in zip(grader["start"], grader["stop"]))  # an empty child was made
+    for key in grader:
+        assert np.array_equal(grader[key], student[key], equal_nan=True), key
+    same_on_x_and_y = np.column_stack([np.zeros(30), np.zeros(30), np.arange(30.0)])
+    assert np.array_equal(trees.kdtree(same_on_x_and_y, 4, partition="value", guard=False)["order"], np.arange(30))
+    duplicates = np.vstack([np.zeros((40, 3)), rng.uniform(size=(10, 3))])
+    for build in (
+        lambda: trees.kdtree(duplicates, 4, partition="value", guard=False),
+        lambda: _plain_trees.kdtree_build(duplicates, 4, partition="value, unguarded"),
+    ):
+        with pytest.raises(RecursionError):
+            build()
