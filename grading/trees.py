@@ -439,13 +439,23 @@ def _csr_rows(rows):
 
 
 def kdtree_search(
-    tree, points, queries, k=None, radius=None, strict=False, far_first=False, prune=True, unsquared=False
+    tree,
+    points,
+    queries,
+    k=None,
+    radius=None,
+    strict_prune=False,
+    strict_keep=False,
+    far_first=False,
+    prune=True,
+    unsquared=False,
 ):
     """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
 
-    The flags give known wrong versions: ``strict`` (the far child only if
-    ``d2 < w2``, radius ``s < r2``), ``far_first``, ``prune=False`` (every leaf),
-    ``unsquared`` (the far child if ``|d| <= w2``: a distance against a squared one).
+    The flags give known wrong versions: ``strict_prune`` (the far child only
+    if ``d2 < w2``), ``strict_keep`` (radius: a point only if ``s < r2``),
+    ``far_first``, ``prune=False`` (every leaf), ``unsquared`` (the far child
+    if ``|d| <= w2``: a distance against a squared one).
     """
     points = np.asarray(points, dtype=float)
     queries = _as_rows(queries, points.shape[1])
@@ -467,7 +477,7 @@ def kdtree_search(
                 if best is not None:
                     best.offer_all(s, indices)
                 else:
-                    keep = (s < radius**2) | ((s == radius**2) & (not strict))
+                    keep = (s < radius**2) | ((s == radius**2) & (not strict_keep))
                     found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
                 return
             diff = query[tree["axis"][node]] - tree["split"][node]
@@ -479,7 +489,7 @@ def kdtree_search(
             visit(near)
             w2 = best.worst if best is not None else radius**2
             gap = abs(diff) if unsquared else diff * diff
-            if not prune or gap < w2 or (not strict and gap == w2):
+            if not prune or gap < w2 or (not strict_prune and gap == w2):
                 visit(far)
 
         visit(0)

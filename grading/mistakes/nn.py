@@ -262,7 +262,7 @@ KDTREE_KNN = Model(
             "strict_prune",
             "visit the far child when (q[axis] - split) ** 2 <= w2, inclusive: equal coordinates lie on both "
             "sides of a split, so a tie at the k-th distance can be there",
-            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, strict=True),
+            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, strict_prune=True),
         ),
         Mistake(
             "unsquared_bound",
@@ -286,7 +286,10 @@ KDTREE_RADIUS = Model(
             "strict_radius",
             "the radius is inclusive: keep points with squared distance <= radius ** 2, and visit the far child "
             "when (q[axis] - split) ** 2 <= radius ** 2",
-            lambda tree, points, queries, radius: kdtree_radius(tree, points, queries, radius, strict=True),
+            lambda tree, points, queries, radius: Variants(
+                kdtree_radius(tree, points, queries, radius, strict_prune=prune, strict_keep=keep)
+                for prune, keep in ((True, True), (True, False), (False, True))
+            ),
         ),
     ),
 )
