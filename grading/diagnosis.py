@@ -15,7 +15,9 @@ this order, and stops at the first finding:
    :mod:`grading.mistakes`, which ships with the instructors' grader only):
    each mistake predicts, grader-side, what it would answer on the same
    inputs, and is named when the student's answers equal its predictions on
-   every call where it differs from the right answer;
+   the calls where it differs from the right answer, in more failed tests
+   than contradict it, and in at least as many as fail where it would have
+   answered right (those show another fault);
 5. every failed test expecting a ``ValueError`` the function did not raise;
    or every failed test breaking one and the same rule.
 
@@ -406,6 +408,11 @@ def _debug(function, mistake, why, test):
         print(f"diagnosis of {function}: not {mistake}: {why} in {test}", file=sys.stderr)
 
 
+def _wrong(call, truth, model, arguments):
+    """Whether a call on an input the contract accepts answered wrong: an exception, or not the truth."""
+    return call.raised or not model.same(call.result, truth, arguments)
+
+
 def _known_mistake(function, calls, outcomes, failed, context):
     model = context.get("model")
     if model is None:
@@ -421,6 +428,7 @@ def _known_mistake(function, calls, outcomes, failed, context):
     best, best_key = None, None
     for mistake in model.mistakes:
         matched, contradicted, luck, seen = set(), set(), {}, {}
+        wrong_where_right = set()  # tests with a wrong answer where the mistake gives the right one
         evidence, absent = 0, 0  # calls the mistake predicts; calls where it differs and the answer is right
         compare = mistake.same or model.same
         rejected = False
@@ -438,11 +446,13 @@ def _known_mistake(function, calls, outcomes, failed, context):
             if predicted is None or (truth is not RANDOM and _matches(compare, truth, predicted, arguments)):
                 # The mistake gives the right answer here, or does not apply: no evidence, unless
                 # the mistake is exclusive (then the answer must be right here).
-                if getattr(mistake, "exclusive", False) and truth is not RANDOM:
-                    if call.raised or not model.same(call.result, truth, arguments):
+                if truth is not RANDOM and _wrong(call, truth, model, arguments):
+                    if getattr(mistake, "exclusive", False):
                         _debug(function, mistake.id, "wrong where the mistake is right", call.test)
                         rejected = True
                         break
+                    if predicted is not None:
+                        wrong_where_right.add(call.test)
                 continue
             answer = Raised(call.error_type) if call.raised else call.result
             if _matches(compare, answer, predicted, arguments):
@@ -470,12 +480,21 @@ def _known_mistake(function, calls, outcomes, failed, context):
         if rejected:
             continue
         # A test is explained when the mistake predicts its answers and nothing contradicts it
-        # there; the mistake is named when it explains more tests than contradict it.
+        # there; the mistake is named when it explains more tests than contradict it, and at least
+        # as many as fail where it would have answered right (the code then has another fault:
+        # naming this one would send the student after a mistake the failures do not show).
         explained = tuple(
             t for t in failed if t in matched and t not in contradicted and luck.get(t, 0.0) < CHANCE_LIMIT
         )
-        _debug(function, mistake.id, f"explains {len(explained)}, contradicted by {len(contradicted)}", "all")
-        if explained and len(explained) > len(contradicted):
+        unexplained = [t for t in failed if t in wrong_where_right and t not in matched and t not in contradicted]
+        _debug(
+            function,
+            mistake.id,
+            f"explains {len(explained)}, contradicted by {len(contradicted)}, "
+            f"wrong where it is right in {len(unexplained)}",
+            "all",
+        )
+        if explained and len(explained) > len(contradicted) and len(explained) >= len(unexplained):
             key = (len(explained), -len(contradicted), -absent, evidence)
             if best_key is None or key > best_key:
                 best, best_key = Diagnosis(mistake.id, mistake.message, explained), key

@@ -69,13 +69,19 @@ def brute_radius(points, query, radius):
 # -- builds --------------------------------------------------------------------------------------
 
 
-def bst(keys):
-    """``(left, right)`` of the BST of ``keys`` inserted in order (equal keys go right)."""
+def bst(keys, drop_equal=False):
+    """``(left, right)`` of the BST of ``keys`` inserted in order (equal keys go right).
+
+    ``drop_equal=True`` gives a known wrong build: a key equal to a node's key
+    on its path is not inserted (its node is left with no parent).
+    """
     n = len(keys)
     left, right = np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
     for i in range(1, n):
         node = 0
         while True:
+            if drop_equal and keys[i] == keys[node]:
+                break
             links = left if keys[i] < keys[node] else right
             if links[node] < 0:
                 links[node] = i

@@ -128,6 +128,12 @@ BST_BUILD = Model(
             lambda keys: tuple(np.where(a >= 0, a, -1) for a in reversed(bst_build(keys, equal="left"))),
         ),
         Mistake(
+            "drops_equal_keys",
+            "every key is a node, duplicates included: a key equal to a node's key is inserted to its right, "
+            "not skipped (node i must hang below an earlier node for every i > 0)",
+            lambda keys: trees.bst(_keys(keys), drop_equal=True),
+        ),
+        Mistake(
             "recursive",
             "sorted keys make a path thousands of levels deep: insert with a loop, not one recursive call per "
             "level (Python's recursion limit is 1,000)",

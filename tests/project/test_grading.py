@@ -9,7 +9,7 @@ import pytest
 from _helpers import load_results
 from _helpers import run_grader as grade
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT
+from grading import GRADED_FUNCTIONS, REPO_ROOT, mistakes
 from grading.diagnosis import ONE_LINE_ALREADY
 
 
@@ -267,9 +267,17 @@ def check_wrong_submission(mutant, summary):
         f"{mutant.relative_to(REPO_ROOT)} ({mutant.read_text().splitlines()[0]}) keeps full marks"
     )
     expected = declared_mistake(mutant)
-    if expected is None:
-        return
     extra = summary.get("extra_data", {})
+    if expected is None:
+        # No diagnosis promised, and none of the catalogue's may be given: a mistake the code does
+        # not make would send the student after the wrong fix. (A generic finding may stand.)
+        found = extra.get("diagnoses", {}).get(function)
+        model = mistakes.model(function)
+        catalogue = {m.id for m in model.mistakes} if model is not None else set()
+        assert not found or found["id"] not in catalogue, (
+            f"{mutant.relative_to(REPO_ROOT)}: diagnosed {found['id']}, a mistake it does not make"
+        )
+        return
     public_failed = [t for t in tests if t["visibility"] == "visible" and t["status"] != "passed"]
     if not public_failed:
         # A mistake of structure only the hidden tests catch (lecture 2's lying trees): the instructors'
