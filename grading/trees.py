@@ -504,7 +504,17 @@ def kdtree_search(
 
 
 def octree_search(
-    tree, points, queries, k=None, radius=None, contains=True, early=True, own_first=True, box=False, strict=False
+    tree,
+    points,
+    queries,
+    k=None,
+    radius=None,
+    contains=True,
+    early=True,
+    own_first=True,
+    box=False,
+    strict=False,
+    stop_at_miss=False,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -513,7 +523,8 @@ def octree_search(
     ``own_first=False`` (children in plain code order), ``box`` (a cube
     meets the ball if it meets the ball's bounding box: too weak),
     ``strict`` (a cube meets the ball only if its distance is below the
-    radius: the course scaffold's ``overlaps``, which loses points on a face).
+    radius: the course scaffold's ``overlaps``, which loses points on a face),
+    ``stop_at_miss`` (a leaf's scan ends at its first point outside the ball).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -536,6 +547,8 @@ def octree_search(
                 best.offer_all(s, indices)
             else:
                 keep = np.ones(len(s), dtype=bool) if everything else s <= radius**2
+                if stop_at_miss and not keep.all():
+                    keep[np.argmin(keep) :] = False
                 found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
 
         def radius_visit(node, query=query):

@@ -421,6 +421,12 @@ OCTREE_RADIUS = Model(
             "points at once without descending (the contains shortcut)",
             lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, contains=False),
         ),
+        Mistake(
+            "stops_at_a_miss",
+            "test every point of a leaf: a point outside the ball is skipped (continue) and the scan goes on; "
+            "a return or break there loses the leaf's later points",
+            lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, stop_at_miss=True),
+        ),
     ),
 )
 

@@ -98,7 +98,7 @@ def kdtree_radius(tree, points, queries, radius, prune="<=", keep="<="):
     return _csr_arrays(rows)
 
 
-def _octree_search(tree, xyz, query, k, radius, contains, early, own_first, box, strict):
+def _octree_search(tree, xyz, query, k, radius, contains, early, own_first, box, strict, stop_at_miss=False):
     held = []  # (squared distance, index), sorted
 
     def bound():
@@ -114,6 +114,8 @@ def _octree_search(tree, xyz, query, k, radius, contains, early, own_first, box,
                 held = sorted([*held, (s, int(index))])[:k]
             elif everything or s <= radius**2:
                 held.append((s, int(index)))
+            elif stop_at_miss:  # the leaf's later points are never tested
+                return
 
     def meets(node):
         gap = np.abs(query - tree["center"][node]) - tree["extent"][node]
@@ -150,10 +152,10 @@ def octree_knn(tree, points, queries, k, early=True, own_first=True, box=False, 
     return _knn_arrays(rows, k)
 
 
-def octree_radius(tree, points, queries, radius, contains=True, box=False, strict=False):
+def octree_radius(tree, points, queries, radius, contains=True, box=False, strict=False, stop_at_miss=False):
     """CSR rows of a plain recursive octree search (with the contains shortcut by default)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (contains, False, True, box, strict)
+    flags = (contains, False, True, box, strict, stop_at_miss)
     rows = [_octree_search(tree, xyz, q[:3], None, radius, *flags) for q in np.asarray(queries, dtype=float)]
     return _csr_arrays(rows)
 
