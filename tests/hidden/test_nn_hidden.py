@@ -9,6 +9,11 @@ brute-force answer of the original cloud; a search that reads more
 returns a decoy. The octree's shortcuts get lying geometry of their own:
 children placed far away under an octant the ball contains, and a sibling
 placed on the query after the octant where the search must end.
+
+A search can also fail these tests by losing points where the rule reads
+(an exclusive test, a leaf scan that stops early): then its answer holds
+no planted point, and the failure says that it answers wrong there instead
+of blaming the structure.
 """
 
 import numpy as np
@@ -34,6 +39,20 @@ def structure_failure(what):
         "there (brute force, a library, no pruning, the far side first, or a weaker test than the rule's)",
         rule=f"{what} reads nodes its rule does not reach",
     )
+
+
+def wrong_answer_failure(what):
+    return CheckFailed(
+        f"{what}: your search returned no decoy, so it read nothing the rule skips, yet its answer is not the "
+        "rule's: it misses or misreports points of the nodes the rule reaches",
+        rule=f"{what} answers wrong on the nodes its rule reaches",
+    )
+
+
+def failure(what, answer, planted, planted_failure):
+    """What a failed structure check shows: the planted failure when the answer holds a planted point
+    (the search read what it must not), else a wrong answer (the search lost points, a fault of its own)."""
+    return planted_failure if np.isin(answer, planted).any() else wrong_answer_failure(what)
 
 
 def fair_queries(points, seed, reach, count=N_QUERIES):
@@ -91,7 +110,7 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
             indices, _ = impl.bst_knn(lying, left, right, float(query), k)
             expected = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
             if indices.tolist() != expected.tolist():
-                raise structure_failure("bst_knn")
+                raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"))
 
 
 # -- k-d tree -------------------------------------------------------------------------------------
@@ -120,7 +139,7 @@ def kd_decoy_case(points, leaf_size, seed, k=None, radius=None):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
         lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        yield tree, query, lying
+        yield tree, query, lying, decoys
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -128,12 +147,12 @@ def kd_decoy_case(points, leaf_size, seed, k=None, radius=None):
 def test_kdtree_knn_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 83)
     for k in (1, 8):
-        for tree, query, lying in kd_decoy_case(points, 8, 84 + k, k=k):
+        for tree, query, lying, decoys in kd_decoy_case(points, 8, 84 + k, k=k):
             indices, distances = impl.kdtree_knn(tree, lying, query[None], k)
             try:
                 check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "kdtree_knn")
             except CheckFailed:
-                raise structure_failure("kdtree_knn") from None
+                raise failure("kdtree_knn", indices, decoys, structure_failure("kdtree_knn")) from None
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -151,12 +170,12 @@ def test_kdtree_knn_hidden_float32_input_and_k_equal_n(impl):
 @pytest.mark.points(4)
 def test_kdtree_radius_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 87)
-    for tree, query, lying in kd_decoy_case(points, 8, 88, radius=0.05):
+    for tree, query, lying, decoys in kd_decoy_case(points, 8, 88, radius=0.05):
         result = impl.kdtree_radius(tree, lying, query[None], 0.05)
         try:
             check_csr(result, [trees.brute_radius(points, query, 0.05)], "kdtree_radius")
         except CheckFailed:
-            raise structure_failure("kdtree_radius") from None
+            raise failure("kdtree_radius", result[1], decoys, structure_failure("kdtree_radius")) from None
 
 
 # -- octree ---------------------------------------------------------------------------------------
@@ -190,19 +209,19 @@ def oc_decoy_case(points, leaf_size, seed, k=None, radius=None):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
         lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        yield tree, query, lying
+        yield tree, query, lying, decoys
 
 
 @pytest.mark.grades("octree_radius")
 @pytest.mark.points(3)
 def test_octree_radius_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 90)
-    for tree, query, lying in oc_decoy_case(points, 8, 91, radius=0.06):
+    for tree, query, lying, decoys in oc_decoy_case(points, 8, 91, radius=0.06):
         result = impl.octree_radius(tree, lying, query[None], 0.06)
         try:
             check_csr(result, [trees.brute_radius(points, query, 0.06)], "octree_radius")
         except CheckFailed:
-            raise structure_failure("octree_radius") from None
+            raise failure("octree_radius", result[1], decoys, structure_failure("octree_radius")) from None
 
 
 def subtree(tree, node):
@@ -237,6 +256,9 @@ def test_octree_radius_hidden_reports_a_contained_octant_whole(impl):
         try:
             check_csr(result, [trees.brute_radius(points, query, radius)], "octree_radius")
         except CheckFailed:
+            whole = tree["order"][tree["start"][node] : tree["stop"][node]]
+            if np.isin(whole, result[1]).all():  # the octant was reported whole: the fault is elsewhere
+                raise wrong_answer_failure("octree_radius") from None
             raise CheckFailed(
                 "octree_radius: an octant that the ball contains must be reported whole, without descending "
                 "(the contains test), each point with its true distance",
@@ -253,12 +275,12 @@ def test_octree_radius_hidden_reports_a_contained_octant_whole(impl):
 def test_octree_knn_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 94)
     for k in (1, 6):
-        for tree, query, lying in oc_decoy_case(points, 8, 95 + k, k=k):
+        for tree, query, lying, decoys in oc_decoy_case(points, 8, 95 + k, k=k):
             indices, distances = impl.octree_knn(tree, lying, query[None], k)
             try:
                 check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "octree_knn")
             except CheckFailed:
-                raise structure_failure("octree_knn") from None
+                raise failure("octree_knn", indices, decoys, structure_failure("octree_knn")) from None
 
 
 @pytest.mark.grades("octree_knn")
@@ -290,11 +312,12 @@ def test_octree_knn_hidden_ends_when_the_ball_is_inside_an_octant(impl):
         try:
             check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "octree_knn")
         except CheckFailed:
-            raise CheckFailed(
+            late = CheckFailed(
                 "octree_knn: once an octant has been processed and the ball of the k-th distance lies strictly "
                 "inside its cube, the search must end (early termination), and the query's own child comes first",
                 rule="octree_knn does not end early, or visits children in another order",
-            ) from None
+            )
+            raise failure("octree_knn", indices, [decoy], late) from None
         used += 1
         if used == 4:
             break

@@ -539,3 +539,18 @@ def test_a_killed_run_leaves_valid_partial_results(tmp_path):
     not_run = [t for t in summary["tests"] if t["text"] == "not run: grading stopped before this test"]
     assert not_run and all(t["score"] == 0 for t in not_run)
     assert summary["score"] == sum(t["score"] for t in summary["tests"])
+
+
+def test_a_hidden_structure_test_tells_a_decoy_read_from_points_lost(tmp_path):
+    """A lying tree fails both a search that reads too much and one that loses points; its one line tells
+    which (a planted point in the answer, or none), so a student who lost points is not sent after pruning."""
+    mutants = REPO_ROOT / "tests" / "mutants" / "octree_radius"
+    (tmp_path / "read").mkdir(), (tmp_path / "lost").mkdir()
+    read = grade_one_function(mutants / "brute_force.py", tmp_path / "read")
+    lost = grade_one_function(mutants / "stops_at_a_miss.py", tmp_path / "lost")
+
+    def line(summary):
+        return next(t["text"] for t in summary["tests"] if "hidden_reads_only_what_its_rule_reaches" in t["name"])
+
+    assert "octree_radius reads nodes its rule does not reach" in line(read)
+    assert "octree_radius answers wrong on the nodes its rule reaches" in line(lost)
