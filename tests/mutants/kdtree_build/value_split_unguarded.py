@@ -1,6 +1,7 @@
-"""Splits by value with no guard: points below the split go left, the rest right. On equal coordinates the
-lower side is empty and the upper side is the whole node, so the recursion never ends (a real student's first
-build: Python stops it at its recursion limit)."""
+"""Splits by value with no guard: points below the split go left, the rest right. Where the lower side is empty
+the node gets an empty child and the same points are split again on the next axis; where they agree on every
+axis the recursion never ends, and Python stops it at its recursion limit (the build before the guard of
+value_split.py)."""
 
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_build as _reference
