@@ -440,6 +440,7 @@ def _known_mistake(function, calls, outcomes, failed, context):
                 predicted = mistake.predict(**copy.deepcopy(arguments))
             except Exception:
                 predicted = None
+            applies = predicted is not None  # None: the mistake does not apply to this input
             if isinstance(predicted, Variants) and truth is not RANDOM:
                 # Only the ways of making the mistake that change the answer are evidence.
                 predicted = Variants(v for v in predicted if not _matches(compare, truth, v, arguments)) or None
@@ -451,7 +452,7 @@ def _known_mistake(function, calls, outcomes, failed, context):
                         _debug(function, mistake.id, "wrong where the mistake is right", call.test)
                         rejected = True
                         break
-                    if predicted is not None:
+                    if applies:
                         wrong_where_right.add(call.test)
                 continue
             answer = Raised(call.error_type) if call.raised else call.result
