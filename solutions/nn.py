@@ -5,7 +5,6 @@ The trees and their searches are compiled (``solutions/_fast/kdtree.py`` and
 (``pcl_course/nn.py``), which state the contract.
 """
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
@@ -26,7 +25,7 @@ from solutions._fast import kdtree as _kdtree
 from solutions._fast import octree as _octree
 from solutions._fast.order import morton_order
 from solutions._fast.rows import unpermute_rows
-from solutions._fast.threads import in_threads
+from solutions._fast.threads import in_threads, map_slices, threshold, worker_count
 
 # Above this many queries, kNN visits them along a Z-order curve: consecutive queries then
 # walk the same nodes, which stay in cache (the answers are the same in any order).
@@ -117,11 +116,12 @@ def _kdtree_in_threads(points, leaf_size):
     axis, split = np.full(nodes, -1, dtype=np.int64), np.full(nodes, np.nan)
     left, right = np.full(nodes, -1, dtype=np.int64), np.full(nodes, -1, dtype=np.int64)
     arrays = (order, start, stop, axis, split, left, right)
-    cores = os.cpu_count() or 1
+    cores = worker_count()
+    serial = n < threshold(_PARALLEL_BUILD_POINTS)
     subtrees, pending = [], [(0, n, 0, 0)]  # (lo, hi, depth, node id)
     while pending:
         lo, hi, depth, node = pending.pop()
-        if n < _PARALLEL_BUILD_POINTS or hi - lo <= leaf_size or len(subtrees) + len(pending) >= 4 * cores - 1:
+        if serial or hi - lo <= leaf_size or len(subtrees) + len(pending) >= 4 * cores - 1:
             subtrees.append((lo, hi, depth, node))
             continue
         start[node], stop[node], axis[node] = lo, hi, depth % points.shape[1]
@@ -155,7 +155,7 @@ def kdtree_knn(tree, points, queries, k):
 def _knn_in_locality_order(kernel, arrays, points, queries, k):
     """Run a kNN kernel over every core, on the queries in Z-order when there are many."""
     permutation = None
-    if len(queries) >= _LOCALITY_QUERIES and queries.shape[1] >= 3:
+    if len(queries) >= threshold(_LOCALITY_QUERIES) and queries.shape[1] >= 3:
         permutation = morton_order(queries[:, :3])
         queries = np.ascontiguousarray(queries[permutation])
     indices = np.empty((len(queries), k), dtype=np.int64)
@@ -170,7 +170,7 @@ def _knn_in_locality_order(kernel, arrays, points, queries, k):
 
 def _csr_in_locality_order(rows_kernel, arrays, points, queries, r2):
     """A radius search into CSR arrays, on the queries in Z-order when there are many."""
-    if len(queries) < _LOCALITY_QUERIES or queries.shape[1] < 3:
+    if len(queries) < threshold(_LOCALITY_QUERIES) or queries.shape[1] < 3:
         return _csr(rows_kernel, (*arrays, points, queries, r2), len(queries))
     permutation = morton_order(queries[:, :3])
     rows = _csr(rows_kernel, (*arrays, points, np.ascontiguousarray(queries[permutation]), r2), len(queries))
@@ -179,14 +179,7 @@ def _csr_in_locality_order(rows_kernel, arrays, points, queries, r2):
 
 def _csr(rows_kernel, inputs, n_queries):
     """A radius search into CSR arrays: slices of queries on every core, each in one pass."""
-    cores = os.cpu_count() or 1
-    slices = max(1, min(16 * cores, n_queries // 1024))
-    bounds = np.linspace(0, n_queries, slices + 1).astype(np.int64)
-    if slices == 1:
-        parts = [rows_kernel(*inputs, 0, n_queries)]
-    else:
-        with ThreadPoolExecutor(cores) as pool:
-            parts = list(pool.map(lambda i: rows_kernel(*inputs, bounds[i], bounds[i + 1]), range(slices)))
+    parts = map_slices(rows_kernel, n_queries, inputs, grain=1024)
     indptr = np.zeros(n_queries + 1, dtype=np.int64)
     np.cumsum(np.concatenate([part[0] for part in parts]), out=indptr[1:])
     return indptr, np.concatenate([part[1] for part in parts]), np.concatenate([part[2] for part in parts])

@@ -296,8 +296,16 @@ def _normal_kernel(points, tree, k, leaf_from, leaf_to, out_normal, out_curvatur
             )
 
 
-def _sorted_leaves(xyz):
-    """``(order, points, tree, n_leaves)``: the cloud sorted along the curve, and its leaf tree."""
+def _sorted_leaves(xyz, k, skip_self):
+    """``(order, points, tree, n_leaves)``: the cloud sorted along the curve, and its leaf tree.
+
+    Checks ``k`` first: with fewer than ``k`` candidates a query's heap never
+    fills, and the kernels would hand on its unset slots (row numbers read
+    from uninitialised memory).
+    """
+    candidates = len(xyz) - 1 if skip_self else len(xyz)
+    if not 1 <= k <= candidates:
+        raise ValueError(f"k must be between 1 and {candidates} for {len(xyz)} points, got {k}")
     order = morton_order(xyz)
     points = np.ascontiguousarray(xyz[order])
     return order, points, _leaf_tree(points, LEAF_SIZE), (len(xyz) + LEAF_SIZE - 1) // LEAF_SIZE
@@ -328,7 +336,7 @@ def leaf_knn(xyz, k, skip_self=False):
     indices : ndarray of int64, shape (N, k)
         Among equidistant candidates at the k-th distance, which are kept is unspecified.
     """
-    order, points, tree, n_leaves = _sorted_leaves(xyz)
+    order, points, tree, n_leaves = _sorted_leaves(xyz, k, skip_self)
     distance_sq = np.empty((len(xyz), k))
     rows = np.empty((len(xyz), k), dtype=np.int64)
     in_threads(_lists_kernel, n_leaves, (points, tree, k, skip_self), (distance_sq, rows), grain=8)
@@ -337,7 +345,7 @@ def leaf_knn(xyz, k, skip_self=False):
 
 def knn_mean_distance(xyz, k):
     """Mean distance from every point to its k nearest *other* points (duplicates count, at 0)."""
-    order, points, tree, n_leaves = _sorted_leaves(xyz)
+    order, points, tree, n_leaves = _sorted_leaves(xyz, k, skip_self=True)
     mean = np.empty(len(xyz))
     in_threads(_mean_distance_kernel, n_leaves, (points, tree, k), (mean,), grain=8)
     return _unsort(order, mean)
@@ -345,7 +353,7 @@ def knn_mean_distance(xyz, k):
 
 def knn_normals(xyz, k):
     """Normal and curvature of the k nearest points of every point, itself included (``k >= 3``)."""
-    order, points, tree, n_leaves = _sorted_leaves(xyz)
+    order, points, tree, n_leaves = _sorted_leaves(xyz, k, skip_self=False)
     normal = np.empty((len(xyz), 3))
     curvature = np.empty(len(xyz))
     in_threads(_normal_kernel, n_leaves, (points, tree, k), (normal, curvature), grain=8)

@@ -23,6 +23,9 @@ from solutions._fast.grid import grid_is_usable, grid_radius_count
 from solutions._fast.knn import leaf_knn
 from solutions._fast.voxel import hash_groups
 
+# Run again with numba's bounds checking: tests/project/test_kernels.py.
+pytestmark = pytest.mark.kernels
+
 
 def _clouds():
     """Clouds that stress the fast paths: volume, surface, line, lattice ties, duplicates, far away."""

@@ -9,11 +9,15 @@ own data.
 
 import numpy as np
 import open3d as o3d
+import pytest
 from graded.test_downsampling import greedy_farthest_points
 from graded.test_normals import abs_cos, sklearn_normals, sphere_points
 
 from solutions.downsampling import farthest_point_sampling
 from solutions.normals import estimate_normals
+
+# Run again with numba's bounds checking: tests/project/test_kernels.py.
+pytestmark = pytest.mark.kernels
 
 
 def test_the_greedy_farthest_points_are_open3ds():

@@ -7,6 +7,9 @@ import pytest
 from grading import trees
 from solutions import nn
 
+# Run again with numba's bounds checking: tests/project/test_kernels.py.
+pytestmark = pytest.mark.kernels
+
 CLOUDS = {
     "uniform": lambda rng: rng.uniform(size=(600, 3)),
     "grid": lambda rng: np.stack(np.meshgrid(*[np.arange(6.0)] * 3, indexing="ij"), -1).reshape(-1, 3),

@@ -1,0 +1,290 @@
+"""Every compiled kernel of ``solutions/_fast``, on the inputs that stress it, on many threads, bounds-checked.
+
+numba checks no index by default: a kernel that reads or writes out of range
+corrupts memory silently, and on threads shows only now and then, as a crash
+of the process that ran it. So every test of the kernels (marker
+``kernels``: this module, ``test_fast_paths.py``, ``test_trees.py`` and
+``test_oracles.py``) and every graded test of the references runs a second
+time with numba's bounds checking on (:func:`test_the_kernel_tests_pass_bounds_checked`):
+an index out of range is then an ``IndexError`` in the test that made it.
+
+The stress: clouds of one, two and k + 1 points, one leaf and one leaf and a
+point, every point equal, lattice ties, a line, coordinates far from the
+origin; every threaded path on 16 threads over slices of one item
+(:func:`solutions._fast.threads.stress_slicing`), so that tiny inputs are
+cut as finely as a scan. The answers are checked against brute force and
+SciPy, and :func:`test_every_kernel_runs_here` fails when a kernel is added
+that nothing here calls.
+"""
+
+import importlib
+import os
+import pkgutil
+import subprocess
+import sys
+
+import numba
+import numpy as np
+import plain  # tests/project/plain.py
+import pytest
+from scipy.spatial import cKDTree
+
+import solutions._fast
+from grading import REPO_ROOT, trees
+from solutions import downsampling, filters, nn, normals
+from solutions._fast.grid import grid_radius_count
+from solutions._fast.knn import LEAF_SIZE, leaf_knn
+from solutions._fast.threads import stress_slicing
+
+pytestmark = pytest.mark.kernels
+
+
+def _stress_clouds():
+    rng = np.random.default_rng(20261203)  # its own stream: the clouds do not depend on test order
+    cube = rng.random((300, 3))
+    return {
+        "one point": rng.random((1, 3)),
+        "two points": rng.random((2, 3)),
+        "one leaf": rng.random((LEAF_SIZE, 3)),
+        "one leaf and a point": rng.random((LEAF_SIZE + 1, 3)),
+        "all equal": np.tile(rng.random(3), (70, 1)),
+        "pairs": np.repeat(rng.random((40, 3)), 2, axis=0),
+        "lattice": np.stack(np.meshgrid(*[np.arange(5.0)] * 3, indexing="ij"), -1).reshape(-1, 3),
+        "line": np.c_[rng.random(90), np.zeros((90, 2))],
+        "far": cube * [3.0, 2.0, 0.1] + 1e6,
+        "cube": cube,
+    }
+
+
+CLOUDS = _stress_clouds()
+
+
+@pytest.fixture(autouse=True)
+def many_threads():
+    """Every test here runs its kernels on 16 threads over slices of one item."""
+    with stress_slicing(threads=16, slice_items=1):
+        yield
+
+
+def _ks(n, skip_self=False):
+    """Neighbour counts at the edges: 1, the largest allowed, and one in between."""
+    largest = n - 1 if skip_self else n
+    return sorted({k for k in (1, min(7, largest), largest) if 1 <= k <= largest})
+
+
+# --- lecture 1: Z-order leaves, grid counts, normals, filters, voxels, FPS --------------------------
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_leaf_knn_under_stress(name):
+    points = CLOUDS[name]
+    scale = max(1.0, float(np.abs(points).max()))
+    for skip_self in (False, True):
+        for k in _ks(len(points), skip_self):
+            distances, indices = leaf_knn(points, k, skip_self)
+            expected = cKDTree(points).query(points, k=k + 1)[0].reshape(len(points), -1)
+            expected = expected[:, 1 : k + 1] if skip_self else expected[:, :k]
+            np.testing.assert_allclose(distances, expected, rtol=0, atol=1e-12 * scale, err_msg=f"k={k}")
+            assert indices.min() >= 0 and indices.max() < len(points)
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_normals_and_filters_under_stress(name):
+    points = CLOUDS[name]
+    n = len(points)
+    scale = float(np.ptp(points, axis=0).max()) or 1.0
+    for k in _ks(n):
+        result, curvature = normals.estimate_normals(points, k=k)
+        _, expected_curvature = plain.estimate_normals(points, k)
+        np.testing.assert_array_equal(np.isfinite(curvature), np.isfinite(expected_curvature), err_msg=f"k={k}")
+        np.testing.assert_allclose(np.linalg.norm(result[np.isfinite(curvature)], axis=1), 1.0, atol=1e-9)
+    _, curvature = normals.estimate_normals(points, k=5, radius=0.3 * scale)
+    _, expected_curvature = plain.estimate_normals(points, 5, 0.3 * scale)
+    np.testing.assert_array_equal(np.isfinite(curvature), np.isfinite(expected_curvature))
+    for k in _ks(n, skip_self=True):
+        np.testing.assert_array_equal(
+            filters.statistical_outlier_removal(points, k, 1.0), plain.statistical_outlier_mask(points, k, 1.0)
+        )
+    for radius in (0.1 * scale, scale):
+        np.testing.assert_array_equal(
+            grid_radius_count(points, radius) - 1, plain.radius_neighbour_counts(points, radius)
+        )
+        np.testing.assert_array_equal(
+            filters.radius_outlier_removal(points, radius, 1), plain.radius_neighbour_counts(points, radius) >= 1
+        )
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_voxels_and_sampling_under_stress(name):
+    points = CLOUDS[name]
+    n = len(points)
+    extent = float(np.ptp(points, axis=0).max()) or 1.0
+    # A dense table of cells, hashed int64 keys, and keys beyond int64 (solutions/downsampling.py).
+    for size in (extent / 4, extent / 1000, extent * 1e-16):
+        np.testing.assert_allclose(
+            downsampling.voxel_grid_downsample(points, size), plain.voxel_grid_centroids(points, size), rtol=1e-12
+        )
+        chosen = downsampling.voxel_grid_downsample(points, size, method="random", rng=1)
+        assert len(chosen) == len(plain.voxel_groups(points, size))
+    size = extent / 4
+    for containers in (1, 7, 10**6):
+        groups = plain.approximate_voxel_groups(points, size, containers)
+        expected = np.array([points[g].mean(axis=0) for g in groups])
+        result = downsampling.approximate_voxel_downsample(points, size, containers)
+        np.testing.assert_allclose(result, expected, rtol=1e-12)
+        assert len(downsampling.approximate_voxel_downsample(points, size, containers, "random", rng=2)) == len(groups)
+    for n_samples, start in ((1, 0), (n, n - 1), (max(1, n // 2), n // 3)):
+        np.testing.assert_array_equal(
+            downsampling.farthest_point_sampling(points, n_samples, start_index=start),
+            plain.farthest_point_sampling(points, n_samples, start),
+        )
+
+
+# --- lecture 2: the BST, the k-d tree and the octree ------------------------------------------------
+
+
+def _queries(points):
+    """The points themselves (every tie), a few inside, and one far away."""
+    rng = np.random.default_rng(len(points))
+    lower, upper = points.min(axis=0), points.max(axis=0)
+    inside = lower + rng.random((5, points.shape[1])) * np.maximum(upper - lower, 1.0)
+    return np.vstack([points, inside, upper + 1e3])
+
+
+def _assert_same(result, expected, what):
+    for got, want in zip(result, expected):
+        np.testing.assert_array_equal(np.asarray(got).shape, np.asarray(want).shape, err_msg=what)
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=0, err_msg=what)
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_trees_under_stress(name):
+    # The expected answers: the grader's plain searches, which follow the contract's
+    # rules literally (grading/trees.py). They equal brute force except where a
+    # rule's floating-point test prunes a point at distance 0 from a radius-0 query.
+    points = CLOUDS[name]
+    queries = _queries(points)
+    scale = float(np.ptp(points, axis=0).max()) or 1.0
+    for leaf_size in (1, 16):
+        kd = nn.kdtree_build(points, leaf_size=leaf_size)
+        octree = nn.octree_build(points, leaf_size=leaf_size)
+        for k in _ks(len(points)):
+            what = f"leaf_size={leaf_size}, k={k}"
+            _assert_same(nn.kdtree_knn(kd, points, queries, k), trees.kdtree_search(kd, points, queries, k=k), what)
+            _assert_same(
+                nn.octree_knn(octree, points, queries, k), trees.octree_search(octree, points, queries, k=k), what
+            )
+            _assert_same(nn.kdtree_knn(kd, points, queries, k), _brute_knn(points, queries, k), what)
+        for radius in (0.0, 0.2 * scale, 2 * scale):
+            what = f"leaf_size={leaf_size}, radius={radius}"
+            expected = trees.kdtree_search(kd, points, queries, radius=radius)
+            _assert_same(nn.kdtree_radius(kd, points, queries, radius), expected, what)
+            expected = trees.octree_search(octree, points, queries, radius=radius)
+            _assert_same(nn.octree_radius(octree, points, queries, radius), expected, what)
+
+
+def _brute_knn(points, queries, k):
+    rows = [trees.brute_knn(points, query, k) for query in queries]
+    return np.array([row[0] for row in rows]), np.array([row[1] for row in rows])
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_bst_under_stress(name):
+    keys = CLOUDS[name][:, 0]
+    left, right = nn.bst_build(keys)
+    for query in (*keys[:5], keys.min() - 1.0, keys.max() + 1.0):
+        for k in _ks(len(keys)):
+            indices, distances = nn.bst_knn(keys, left, right, query, k)
+            expected = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
+            np.testing.assert_array_equal(indices, expected, err_msg=f"query {query}, k={k}")
+    distances = np.abs(keys - keys[0])
+    for k in _ks(len(keys)):
+        indices, _, _ = nn.knn_result_set(distances, np.arange(len(keys)), k)
+        np.testing.assert_array_equal(indices, np.lexsort((np.arange(len(keys)), distances))[:k])
+
+
+# --- every kernel is reached, and the checked run ----------------------------------------------------
+
+
+def _dispatchers():
+    """Every numba dispatcher defined in ``solutions/_fast``, by ``module.name``."""
+    found = {}
+    for module_info in pkgutil.iter_modules(solutions._fast.__path__):
+        module = importlib.import_module(f"solutions._fast.{module_info.name}")
+        for name, value in vars(module).items():
+            if isinstance(value, numba.core.dispatcher.Dispatcher) and value.__module__ == module.__name__:
+                found[f"{module_info.name}.{name}"] = value
+    return found
+
+
+def _reached(dispatchers):
+    """The dispatchers compiled in this process, and every one their code calls, transitively.
+
+    A kernel loaded from numba's cache carries its callees' machine code, so
+    they show no compiled signature of their own: they are reached by name.
+    """
+    by_identity = {id(dispatcher): name for name, dispatcher in dispatchers.items()}
+    reached = {name for name, dispatcher in dispatchers.items() if dispatcher.signatures}
+    pending = list(reached)
+    while pending:
+        function = dispatchers[pending.pop()].py_func
+        for global_name in function.__code__.co_names:
+            callee = by_identity.get(id(function.__globals__.get(global_name)))
+            if callee is not None and callee not in reached:
+                reached.add(callee)
+                pending.append(callee)
+    return reached
+
+
+def test_every_kernel_runs_here():
+    # Run every stress test once more in this process (compiled already: quick);
+    # then every kernel must have run, itself or inside a kernel that calls it.
+    for name in CLOUDS:
+        for test in (
+            test_leaf_knn_under_stress,
+            test_normals_and_filters_under_stress,
+            test_voxels_and_sampling_under_stress,
+            test_trees_under_stress,
+            test_bst_under_stress,
+        ):
+            test(name)
+    dispatchers = _dispatchers()
+    unused = sorted(set(dispatchers) - _reached(dispatchers))
+    assert not unused, f"kernels no stress test here reaches (add a call to this module): {unused}"
+
+
+@pytest.mark.skipif(not numba.config.BOUNDSCHECK, reason="the bounds-checked run only")
+def test_bounds_checking_is_on():
+    """In the checked run, a kernel indexing out of range raises instead of reading memory."""
+
+    @numba.njit
+    def read(values, i):
+        return values[i]
+
+    with pytest.raises(IndexError):
+        read(np.zeros(3), 3)
+
+
+# The kernel tests, and the graded tests of the references in this process (--impl solutions,
+# no sandbox: the sandbox passes no NUMBA_ variable through).
+CHECKED_RUN = [
+    "tests/project/test_kernels.py",
+    "tests/project/test_fast_paths.py",
+    "tests/project/test_trees.py",
+    "tests/project/test_oracles.py",
+    "tests/graded",
+    "tests/hidden",
+]
+
+
+@pytest.mark.timeout(1800)
+@pytest.mark.skipif(bool(numba.config.BOUNDSCHECK), reason="runs the checked run; not inside it")
+def test_the_kernel_tests_pass_bounds_checked(tmp_path):
+    # Its own cache: numba's cache key ignores the bounds-checking flag, so a shared
+    # cache would hand this run the unchecked machine code.
+    env = {**os.environ, "NUMBA_BOUNDSCHECK": "1", "NUMBA_CACHE_DIR": str(REPO_ROOT / "_build" / "numba-boundscheck")}
+    command = [sys.executable, "-m", "pytest", *CHECKED_RUN, "--impl", "solutions", "-m", "kernels or grades"]
+    command += ["-p", "no:xdist", "-p", "no:cacheprovider", "-q", "-x", f"--basetemp={tmp_path / 'run'}"]
+    completed = subprocess.run(command, cwd=REPO_ROOT, env=env, capture_output=True, text=True, timeout=1800)
+    tail = "\n".join((completed.stdout + completed.stderr).splitlines()[-40:])
+    assert completed.returncode == 0, tail
