@@ -7,6 +7,29 @@ import sys
 
 from grading import REPO_ROOT
 
+# -- wall-clock backstops -------------------------------------------------------------------
+# Where cost is the point, the tests limit CPU time (the grader's calls: grading.config.CALL_TIMEOUT);
+# the wall clock only stops what hangs, and must not stop what is merely slow on a busy machine
+# (a shared lab machine, a CI runner). Every wall-clock limit of the project's tests is therefore
+# BUSY_FACTOR times an idle budget, itself above what the step took on an idle 2-core machine during
+# `make test` (both xdist workers busy; measured with `pytest --durations=0`, README "Tests").
+BUSY_FACTOR = 4
+
+
+def backstop(idle_budget):
+    """Wall-clock seconds allowed to a step whose idle budget is ``idle_budget`` seconds."""
+    return BUSY_FACTOR * idle_budget
+
+
+# A whole test: the slowest takes about 60 s idle (the release's book build; the bounds-checked
+# kernel run has its own, test_kernels.py). Applied in tests/project/conftest.py.
+TEST_BACKSTOP = backstop(150)
+# One subprocess a test runs (a grading, a release, a book build, a batch): the slowest about 60 s
+# idle. Below TEST_BACKSTOP, so that the subprocess's own message, not a stack dump, reports it.
+SUBPROCESS_BACKSTOP = backstop(120)
+# One quick command (a workflow step, a probe): a few seconds idle.
+STEP_BACKSTOP = backstop(30)
+
 
 def run_grader(*args, tmp_path):
     """Run ``python -m grading grade ARGS``; return (results summary, stdout)."""
@@ -16,7 +39,7 @@ def run_grader(*args, tmp_path):
         cwd=REPO_ROOT,
         capture_output=True,
         text=True,
-        timeout=900,
+        timeout=SUBPROCESS_BACKSTOP,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     return load_results(results), completed.stdout
@@ -60,7 +83,7 @@ def run_batch(classroom, csv_path, *args):
         cwd=REPO_ROOT,
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=SUBPROCESS_BACKSTOP,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     with open(csv_path, newline="") as handle:

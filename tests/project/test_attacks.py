@@ -20,6 +20,7 @@ import time
 import pytest
 from _helpers import (
     HIDDEN_REFUSAL,
+    SUBPROCESS_BACKSTOP,
     hidden_tests,
     load_results,
     public_tests,
@@ -63,7 +64,7 @@ def grade(submission, tmp_path, *args, as_user=None):
         cwd=REPO_ROOT,
         capture_output=True,
         text=True,
-        timeout=900,
+        timeout=SUBPROCESS_BACKSTOP,
         env=env,
         **kwargs,
     )

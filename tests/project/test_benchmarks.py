@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import pytest
+from _helpers import STEP_BACKSTOP, SUBPROCESS_BACKSTOP
 
 from benchmarks.cases import all_cases
 from benchmarks.report import markdown
@@ -47,7 +48,7 @@ def small_run(tmp_path_factory):
     # A clean environment: under pytest-xdist the PYTEST_* variables of the
     # worker would make pytest-benchmark disable itself in the child.
     env = {key: value for key, value in os.environ.items() if not key.startswith("PYTEST_")}
-    run = subprocess.run(command, cwd=REPO_ROOT, capture_output=True, text=True, timeout=600, env=env)
+    run = subprocess.run(command, cwd=REPO_ROOT, capture_output=True, text=True, timeout=SUBPROCESS_BACKSTOP, env=env)
     assert run.returncode == 0, run.stdout[-3000:] + run.stderr[-3000:]
     assert (out / "raw.json").is_file(), run.stdout[-3000:]
     report = subprocess.run(
@@ -55,7 +56,7 @@ def small_run(tmp_path_factory):
         cwd=REPO_ROOT,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=STEP_BACKSTOP,
     )
     assert report.returncode == 0, report.stderr
     raw = json.loads((out / "raw.json").read_text())

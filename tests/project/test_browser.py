@@ -12,6 +12,7 @@ import shutil
 import threading
 
 import pytest
+from _helpers import STEP_BACKSTOP
 from test_book import HTML, page, pytestmark, toc_files  # noqa: F401 -- pytestmark: skip without a book
 
 from grading import REPO_ROOT
@@ -77,7 +78,9 @@ def test_page_in_a_real_browser(name, site, browser):
     tab.goto(f"{site}/{name}.html", wait_until="load")
 
     if 'class="math' in html:
-        tab.wait_for_function("window.MathJax && MathJax.startup && MathJax.startup.promise", timeout=20000)
+        tab.wait_for_function(
+            "window.MathJax && MathJax.startup && MathJax.startup.promise", timeout=STEP_BACKSTOP * 1000
+        )
         tab.evaluate("MathJax.startup.promise")
         assert tab.locator("mjx-container").count() > 0, f"{name}: math was not typeset"
 
@@ -102,7 +105,9 @@ def test_page_in_a_real_browser(name, site, browser):
     )
     figures = html.count('class="plotly-graph-div"')
     if figures:
-        tab.wait_for_function(f"document.querySelectorAll('.js-plotly-plot canvas').length >= {figures}", timeout=30000)
+        tab.wait_for_function(
+            f"document.querySelectorAll('.js-plotly-plot canvas').length >= {figures}", timeout=STEP_BACKSTOP * 1000
+        )
         assert tab.locator(".js-plotly-plot").count() == figures, f"{name}: not every Plotly figure started"
 
     SCREENSHOTS.mkdir(parents=True, exist_ok=True)
@@ -116,7 +121,9 @@ def test_page_in_a_real_browser(name, site, browser):
 def test_long_code_lines_wrap_and_legends_clear_the_mode_bar(site, browser):
     tab = browser.new_page(viewport={"width": 1280, "height": 900})
     tab.goto(f"{site}/book/downsampling.html", wait_until="load")
-    tab.wait_for_function("document.querySelectorAll('.js-plotly-plot .legend').length > 0", timeout=30000)
+    tab.wait_for_function(
+        "document.querySelectorAll('.js-plotly-plot .legend').length > 0", timeout=STEP_BACKSTOP * 1000
+    )
     code = tab.locator("div.cell_input pre").first
     assert code.evaluate("e => getComputedStyle(e).whiteSpace") == "pre-wrap"
     output = tab.locator("div.cell_output pre").first

@@ -8,6 +8,7 @@ import sys
 import tomllib
 
 import pytest
+from _helpers import SUBPROCESS_BACKSTOP
 
 from grading import REPO_ROOT
 
@@ -77,5 +78,5 @@ def test_the_pins_resolve_for_the_oldest_supported_python(name, platform, binary
     command = [str(uv), "pip", "compile", "--quiet", "--no-header", "--python-version", "3.11.0"]
     command += ["--python-platform", platform, str(REQUIREMENTS / f"{name}.txt"), "-o", "/dev/null"]
     command += ["--only-binary", ":all:"] if binary_only else []
-    completed = subprocess.run(command, capture_output=True, text=True, timeout=300)
+    completed = subprocess.run(command, capture_output=True, text=True, timeout=SUBPROCESS_BACKSTOP)
     assert completed.returncode == 0, completed.stderr[-2000:]

@@ -23,7 +23,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
-from _helpers import load_results, reference_package, reference_source
+from _helpers import SUBPROCESS_BACKSTOP, load_results, reference_package, reference_source
 
 from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, REPO_ROOT
 from grading.leakcheck import find_leaks
@@ -55,7 +55,11 @@ def autograder_root(archive, root):
             os.chmod(root / "source" / info.filename, (info.external_attr >> 16) & 0o777)
     env = dict(os.environ, PCL_SETUP_SKIP_APT="1", PCL_GRADER_VENV=sys.prefix)
     completed = subprocess.run(
-        ["bash", str(root / "source" / "setup.sh")], env=env, capture_output=True, text=True, timeout=600
+        ["bash", str(root / "source" / "setup.sh")],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=SUBPROCESS_BACKSTOP,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     return root
@@ -74,7 +78,7 @@ def run_autograder(root, namespaces=True, wait=True):
         return subprocess.Popen(
             command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True
         )
-    completed = subprocess.run(command, env=env, capture_output=True, text=True, timeout=900)
+    completed = subprocess.run(command, env=env, capture_output=True, text=True, timeout=SUBPROCESS_BACKSTOP)
     assert completed.returncode == 0, completed.stdout + completed.stderr
     results = load_results(root / "results" / "results.json")
     return results, completed.stdout

@@ -9,7 +9,7 @@ import sys
 
 import pytest
 import yaml
-from _helpers import load_results
+from _helpers import STEP_BACKSTOP, SUBPROCESS_BACKSTOP, load_results
 
 from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.leakcheck import find_leaks
@@ -24,7 +24,7 @@ def release_dir(tmp_path_factory):
         cwd=REPO_ROOT,
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=SUBPROCESS_BACKSTOP,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     return out
@@ -145,7 +145,7 @@ def test_the_workflow_names_the_course_repository_when_given(tmp_path):
     assert workflow["jobs"]["check"]["env"]["COURSE_REPOSITORY"] == "cs-dept/pcl-course-2027"
 
 
-def run_step(step, cwd, env=None, timeout=60):
+def run_step(step, cwd, env=None, timeout=STEP_BACKSTOP):
     return subprocess.run(
         ["bash", "-e", "-c", step["run"]],
         cwd=cwd,
@@ -208,7 +208,7 @@ def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
         cwd=release_dir,
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=SUBPROCESS_BACKSTOP,
     )
     assert completed.returncode == 0, completed.stdout + completed.stderr
     summary = load_results(release_dir / "r.json")
@@ -226,7 +226,7 @@ def test_the_release_book_builds_with_the_stubs(release_dir):
         cwd=release_dir,
         capture_output=True,
         text=True,
-        timeout=900,
+        timeout=SUBPROCESS_BACKSTOP,
         env=env,
     )
     assert completed.returncode == 0, completed.stdout[-3000:] + completed.stderr[-3000:]
@@ -262,7 +262,7 @@ def test_the_workflow_grade_step_runs_the_pristine_grader_on_the_submission(rele
         cwd=workspace / step["working-directory"],
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=SUBPROCESS_BACKSTOP,
         env=env,
     )
     assert completed.returncode == 0, completed.stdout[-2000:] + completed.stderr[-2000:]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _helpers import reference_source, run_grader, write_reference_modules
+from _helpers import SUBPROCESS_BACKSTOP, reference_source, run_grader, write_reference_modules
 
 from grading import REPO_ROOT
 from grading.errors import SandboxError
@@ -381,14 +381,21 @@ def test_the_level_is_named_in_the_results_and_can_be_required(tmp_path):
         "--results",
         str(tmp_path / "r.json"),
     ]
-    completed = subprocess.run(base, cwd=REPO_ROOT, capture_output=True, text=True, env=env, timeout=300)
+    completed = subprocess.run(
+        base, cwd=REPO_ROOT, capture_output=True, text=True, env=env, timeout=SUBPROCESS_BACKSTOP
+    )
     assert completed.returncode == 0, completed.stderr
     # Here the course folder is readable by others: no wall, and it says so.
     note = json.loads((tmp_path / "r.json").read_text())["output"]
     assert note.startswith("NOT ISOLATED") and "a local check, not a mark" in note
     assert "NOT ISOLATED" in completed.stdout.splitlines()[-2] + completed.stdout.splitlines()[-1]
     refused = subprocess.run(
-        [*base, "--require-isolation"], cwd=REPO_ROOT, capture_output=True, text=True, env=env, timeout=300
+        [*base, "--require-isolation"],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=SUBPROCESS_BACKSTOP,
     )
     assert refused.returncode == 1
     assert refused.stderr.startswith("error: refusing to grade: the submission could not be isolated")

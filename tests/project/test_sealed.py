@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 import pytest
-from _helpers import load_results, reference_package, run_grader
+from _helpers import SUBPROCESS_BACKSTOP, load_results, reference_package, run_grader
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
 from grading.errors import SandboxError
@@ -309,7 +309,7 @@ def test_the_graders_memory_stays_bounded_whatever_a_worker_sends(tmp_path):
     (package / "evil.py").write_text(FRAMES)
     script = MEASURE.format(tests=str(REPO_ROOT / "tests"), package=str(package), payloads=PAYLOADS)
     completed = subprocess.run(
-        [sys.executable, "-c", script], cwd=REPO_ROOT, capture_output=True, text=True, timeout=600
+        [sys.executable, "-c", script], cwd=REPO_ROOT, capture_output=True, text=True, timeout=SUBPROCESS_BACKSTOP
     )
     assert completed.returncode == 0, completed.stderr[-3000:]
     measured = json.loads(completed.stdout.strip().splitlines()[-1])
@@ -364,7 +364,7 @@ def test_a_whole_grading_with_the_largest_answers_stays_under_500_mib(tmp_path):
         "--function", "chamfer_distance", "--function", "depth_metrics", "--function", "estimate_normals",
     ]  # fmt: skip
     env = dict(os.environ, PYTHONPATH=str(tmp_path), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
-    subprocess.run(command, cwd=REPO_ROOT, env=env, capture_output=True, timeout=600)
+    subprocess.run(command, cwd=REPO_ROOT, env=env, capture_output=True, timeout=SUBPROCESS_BACKSTOP)
     summary = load_results(results)
     metrics = [t for t in summary["tests"] if t["tags"][0] in ("chamfer_distance", "depth_metrics")]
     assert metrics and all(t["score"] == 0 for t in metrics)  # graded, not refused: the answers got through

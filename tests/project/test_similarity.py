@@ -15,6 +15,7 @@ import sys
 import textwrap
 
 import pytest
+from _helpers import SUBPROCESS_BACKSTOP
 
 from grading import REPO_ROOT
 from grading.similarity import DISPLAY_THRESHOLD, compare_class
@@ -135,7 +136,7 @@ def test_the_report_is_one_self_contained_page_with_the_shared_code_marked(plant
         cwd=REPO_ROOT,
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=SUBPROCESS_BACKSTOP,
     )
     assert completed.returncode == 0, completed.stderr
     first_line = completed.stdout.splitlines()[1]
