@@ -15,7 +15,11 @@ module      what
 ``octree``  lecture 2's octree: build, radius search, kNN with early termination
 ``rows``    the trees' shared pieces: distances, sorted CSR rows, rows un-permuted
 ``bst``     lecture 2's result set and binary search tree
+``sorting`` in-place introsort of a range, alone or with a payload
 ==========  ============================================================
+
+No kernel calls ``np.sort`` or ``np.argsort``: ``sorting`` says why (numba's
+cache can bind their helpers to another process's; a segmentation fault).
 
 Why a package of their own, always imported under the same names
 (``solutions._fast.knn``, ...): numba's on-disk cache (``cache=True``, which

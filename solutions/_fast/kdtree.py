@@ -15,6 +15,7 @@ import numpy as np
 from numba import njit
 
 from solutions._fast.rows import append_row, squared_distance
+from solutions._fast.sorting import sort_range
 
 __all__ = ["node_count", "split_node", "build_range", "knn", "radius_rows", "offer", "stack_size"]
 
@@ -104,21 +105,6 @@ def split_node(points, order, lo, hi, a, scratch):
     return m, (below + above) / 2
 
 
-@njit(cache=True, nogil=True, inline="always")
-def _sort_in_place(values, lo, hi):
-    """Sort ``values[lo:hi]`` in place: insertion sort for a leaf's few entries, else NumPy's."""
-    if hi - lo > 64:
-        values[lo:hi] = np.sort(values[lo:hi])
-        return
-    for j in range(lo + 1, hi):
-        v = values[j]
-        position = j
-        while position > lo and values[position - 1] > v:
-            values[position] = values[position - 1]
-            position -= 1
-        values[position] = v
-
-
 @njit(cache=True, nogil=True)
 def build_range(points, leaf_size, order, start, stop, axis, split, left, right, lo, hi, depth, first_node):
     """Build the subtree of ``order[lo:hi]`` at ``depth`` into the node arrays, numbered from ``first_node``.
@@ -141,7 +127,7 @@ def build_range(points, leaf_size, order, start, stop, axis, split, left, right,
             right[parent] = node
         start[node], stop[node] = lo, hi
         if hi - lo <= leaf_size:
-            _sort_in_place(order, lo, hi)
+            sort_range(order, lo, hi)
             node += 1
             continue
         a = depth % dim

@@ -27,6 +27,7 @@ from scipy.spatial import cKDTree
 
 from solutions._fast.eig3 import patch_normal
 from solutions._fast.order import morton_order
+from solutions._fast.sorting import sort_pairs, sort_range
 from solutions._fast.threads import in_threads
 
 __all__ = ["LEAF_SIZE", "kdtree", "knn_mean_distance", "knn_normals", "leaf_knn"]
@@ -226,7 +227,9 @@ def _leaf_neighbours(points, tree, leaf, skip_self, scratch):
         heaps.count[slot] = 0
         _offer_rows(points, start + slot, slot, seen_from, seen_to, skip_self, heaps)
         first_k_sq[slot] = heaps.distance_sq[slot, 0]
-    limit = 16.0 * np.sort(first_k_sq[:m])[m // 2]  # squared distances: 4x the distance
+    median = first_k_sq[:m].copy()
+    sort_range(median, 0, m)
+    limit = 16.0 * median[m // 2]  # squared distances: 4x the distance
     together, alone = 0, m  # slots[:together] walk as one, slots[alone:m] each on its own
     for slot in range(m):
         if first_k_sq[slot] <= limit:
@@ -262,10 +265,11 @@ def _lists_kernel(points, tree, k, skip_self, leaf_from, leaf_to, out_distance_s
     for leaf in range(leaf_from, leaf_to):
         start, stop = _leaf_neighbours(points, tree, leaf, skip_self, scratch)
         for slot in range(stop - start):
-            ranks = np.argsort(heaps.distance_sq[slot])  # ascending, as a k-d tree returns them
+            # Ascending, as a k-d tree returns them (the heap is refilled at the next leaf).
+            sort_pairs(heaps.distance_sq[slot], heaps.row[slot], 0, k)
             for r in range(k):
-                out_distance_sq[start + slot, r] = heaps.distance_sq[slot, ranks[r]]
-                out_row[start + slot, r] = heaps.row[slot, ranks[r]]
+                out_distance_sq[start + slot, r] = heaps.distance_sq[slot, r]
+                out_row[start + slot, r] = heaps.row[slot, r]
 
 
 @njit(cache=True, nogil=True)

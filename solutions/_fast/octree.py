@@ -11,6 +11,7 @@ from numba import njit
 
 from solutions._fast.kdtree import offer
 from solutions._fast.rows import append_row, squared_distance
+from solutions._fast.sorting import sort_range
 
 __all__ = ["build", "radius_rows", "knn", "stack_size"]
 
@@ -75,7 +76,7 @@ def build(xyz, leaf_size, min_extent):
         e = pending_cube[top, 3]
         extent[node] = e
         if hi - lo <= leaf_size or e <= min_extent:
-            order[lo:hi] = np.sort(order[lo:hi])
+            sort_range(order, lo, hi)
             continue
         # Counting sort of the node's range by child code (stable).
         tally = np.zeros(9, dtype=np.int64)

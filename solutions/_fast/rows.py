@@ -10,6 +10,8 @@ then each run of equal distances is sorted by index.
 import numpy as np
 from numba import njit
 
+from solutions._fast.sorting import sort_pairs
+
 __all__ = ["squared_distance", "sort_row", "append_row", "unpermute_rows"]
 
 _INSERTION_LIMIT = 48
@@ -29,16 +31,7 @@ def squared_distance(points, index, query):
 def sort_row(s, index, count):
     """Sort ``s[:count]`` and ``index[:count]`` in place, ascending by (s, index)."""
     if count > _INSERTION_LIMIT:
-        rank = np.argsort(s[:count])  # by distance only; then the rare runs of equal distances by index
-        s[:count], index[:count] = s[:count][rank], index[:count][rank]
-        first = 0
-        while first < count:
-            end = first + 1
-            while end < count and s[end] == s[first]:
-                end += 1
-            if end - first > 1:
-                index[first:end] = np.sort(index[first:end])
-            first = end
+        sort_pairs(s, index, 0, count)
         return
     for j in range(1, count):
         sj, ij = s[j], index[j]

@@ -22,6 +22,7 @@ import os
 import pkgutil
 import subprocess
 import sys
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -35,6 +36,7 @@ from grading import REPO_ROOT, trees
 from solutions import downsampling, filters, nn, normals
 from solutions._fast.grid import grid_radius_count
 from solutions._fast.knn import LEAF_SIZE, leaf_knn
+from solutions._fast.sorting import sort_pairs, sort_range
 from solutions._fast.threads import stress_slicing
 
 pytestmark = pytest.mark.kernels
@@ -204,6 +206,44 @@ def test_bst_under_stress(name):
         np.testing.assert_array_equal(indices, np.lexsort((np.arange(len(keys)), distances))[:k])
 
 
+# --- the kernels' own sort ------------------------------------------------------------------------------
+
+
+def _sort_cases():
+    rng = np.random.default_rng(20261204)
+    for n in (0, 1, 2, 16, 17, 100, 5000):
+        yield f"random {n}", rng.random(n)
+        yield f"few values {n}", rng.integers(0, 3, n).astype(float)
+    yield "sorted", np.arange(3000.0)
+    yield "reversed", np.arange(3000.0)[::-1].copy()
+    yield "all equal", np.ones(3000)
+    yield "organ pipe", np.r_[np.arange(1500.0), np.arange(1500.0)[::-1]]
+
+
+@pytest.mark.parametrize("name, keys", list(_sort_cases()), ids=lambda v: v if isinstance(v, str) else "")
+def test_the_kernels_sort_is_numpys(name, keys):
+    values = keys.copy()
+    sort_range(values, 0, len(values))
+    np.testing.assert_array_equal(values, np.sort(keys))
+    ids = np.random.default_rng(len(keys)).permutation(len(keys)).astype(np.int64)
+    pair_keys, payload = keys.copy(), ids.copy()
+    sort_pairs(pair_keys, payload, 0, len(keys))
+    rank = np.lexsort((ids, keys))
+    np.testing.assert_array_equal(pair_keys, keys[rank])
+    np.testing.assert_array_equal(payload, ids[rank])
+    if len(keys) > 4:  # a range of a larger array: nothing outside it moves
+        inner = keys.copy()
+        sort_range(inner, 1, len(keys) - 2)
+        np.testing.assert_array_equal(inner[[0, -2, -1]], keys[[0, -2, -1]])
+        np.testing.assert_array_equal(inner[1:-2], np.sort(keys[1:-2]))
+
+
+# Helpers numba builds from factories: several closures share one qualified name and one signature
+# (sort and argsort, a comparison or another), told apart only by the compiling process's counter.
+# A kernel that carries one can be bound, in another process, to the other closure (solutions/_fast/sorting.py).
+FACTORY_HELPERS = (b"4misc9quicksort", b"4misc9mergesort", b"18_partition_factory")
+
+
 # --- every kernel is reached, and the checked run ----------------------------------------------------
 
 
@@ -237,6 +277,16 @@ def _reached(dispatchers):
     return reached
 
 
+def _cached_helpers(dispatcher):
+    """The factory-made helpers in the machine code of ``dispatcher``'s current cache entries."""
+    cache_file = dispatcher._cache._cache_file
+    found = set()
+    for data_name in cache_file._load_index().values():
+        data = (Path(dispatcher._cache.cache_path) / data_name).read_bytes()
+        found.update(helper for helper in FACTORY_HELPERS if helper in data)
+    return found
+
+
 def test_every_kernel_runs_here():
     # Run every stress test once more in this process (compiled already: quick);
     # then every kernel must have run, itself or inside a kernel that calls it.
@@ -252,6 +302,10 @@ def test_every_kernel_runs_here():
     dispatchers = _dispatchers()
     unused = sorted(set(dispatchers) - _reached(dispatchers))
     assert not unused, f"kernels no stress test here reaches (add a call to this module): {unused}"
+    # No kernel's entry in numba's cache (what other processes load) carries a helper that could
+    # be bound there to another process's closure. (numba's private cache API: tests only.)
+    carrying = sorted(name for name, dispatcher in dispatchers.items() if _cached_helpers(dispatcher))
+    assert not carrying, f"kernels carrying numba's factory-made sort helpers (use solutions._fast.sorting): {carrying}"
 
 
 @pytest.mark.skipif(not numba.config.BOUNDSCHECK, reason="the bounds-checked run only")
