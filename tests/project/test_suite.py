@@ -2,6 +2,7 @@
 derived from one busy factor (``tests/_helpers.py``), never a bare number tuned on an idle one."""
 
 import ast
+import tomllib
 
 from _helpers import BUSY_FACTOR, SUBPROCESS_BACKSTOP, TEST_BACKSTOP
 
@@ -29,6 +30,12 @@ def _bare_timeouts(path):
 def test_no_wall_clock_limit_in_the_tests_is_a_bare_number():
     bare = {path.name: lines for path in SOURCES if (lines := _bare_timeouts(path))}
     assert not bare, f"use tests/_helpers.py's backstop(...) for: {bare}"
+
+
+def test_the_ini_backstop_is_the_tests_own():
+    # pytest-timeout's default (notebook cells under nbval, anything outside tests/project).
+    ini = tomllib.loads((REPO_ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]
+    assert float(ini["timeout"]) == TEST_BACKSTOP
 
 
 def test_the_backstops_allow_a_machine_four_times_busier():
