@@ -105,6 +105,21 @@ def split_node(points, order, lo, hi, a, scratch):
     return m, (below + above) / 2
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _sort_in_place(values, lo, hi):
+    """Sort ``values[lo:hi]`` in place: insertion sort for a leaf's few entries, else the kernels' introsort."""
+    if hi - lo > 64:
+        sort_range(values, lo, hi)
+        return
+    for j in range(lo + 1, hi):
+        v = values[j]
+        position = j
+        while position > lo and values[position - 1] > v:
+            values[position] = values[position - 1]
+            position -= 1
+        values[position] = v
+
+
 @njit(cache=True, nogil=True)
 def build_range(points, leaf_size, order, start, stop, axis, split, left, right, lo, hi, depth, first_node):
     """Build the subtree of ``order[lo:hi]`` at ``depth`` into the node arrays, numbered from ``first_node``.
@@ -127,7 +142,7 @@ def build_range(points, leaf_size, order, start, stop, axis, split, left, right,
             right[parent] = node
         start[node], stop[node] = lo, hi
         if hi - lo <= leaf_size:
-            sort_range(order, lo, hi)
+            _sort_in_place(order, lo, hi)
             node += 1
             continue
         a = depth % dim
