@@ -3,8 +3,8 @@
 A radius search finds a query's points in tree order; the contract wants each
 row ascending by (squared distance, index). Rows are short for the radii of
 point-cloud work, and an insertion sort in place beats an argsort with its
-allocations there. Long rows (a large radius) are argsorted by distance,
-then each run of equal distances is sorted by index.
+allocations there. Long rows (a large radius) are sorted in place by
+(distance, index) with the kernels' introsort (``sorting.py``).
 """
 
 import numpy as np
