@@ -14,7 +14,9 @@ origin; every threaded path on 16 threads over slices of one item
 (:func:`solutions._fast.threads.stress_slicing`), so that tiny inputs are
 cut as finely as a scan. The answers are checked against brute force and
 SciPy, and :func:`test_every_kernel_runs_here` fails when a kernel is added
-that nothing here calls.
+that nothing here calls, or when a kernel's entry in numba's cache carries
+numba's own sort helpers, which another process can link to a different
+closure (the crash of issue 33: ``solutions/_fast/sorting.py``).
 """
 
 import importlib
