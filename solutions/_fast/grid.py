@@ -10,6 +10,7 @@ import numpy as np
 from numba import njit
 
 from solutions._fast.bounds import axis_bounds
+from solutions._fast.sorting import search_left
 from solutions._fast.threads import in_threads
 
 __all__ = ["CELL_MARGIN", "MAX_CELLS_PER_AXIS", "Grid", "grid_is_usable", "grid_radius_count"]
@@ -66,7 +67,7 @@ def grid_is_usable(xyz, radius):
 @njit(cache=True, nogil=True, inline="always")
 def _cell_run(keys, starts, first_key, last_key):
     """Rows of the points in the occupied cells with keys ``first_key..last_key`` (a run along x)."""
-    return starts[np.searchsorted(keys, first_key)], starts[np.searchsorted(keys, last_key + 1)]
+    return starts[search_left(keys, first_key)], starts[search_left(keys, last_key + 1)]
 
 
 @njit(cache=True, nogil=True)

@@ -1,22 +1,24 @@
-"""In-place sorts for the kernels: introsort of a range, alone or with a payload (numba).
+"""Sorting and searching for the kernels: introsort of a range, alone or with a payload, and binary search (numba).
 
-Why not ``np.sort`` and ``np.argsort`` inside a kernel: numba builds their
-helpers from factories (``numba.misc.quicksort``: one closure for sort, one
-for argsort, ...) whose machine-code names differ only by a counter of the
-process that compiled them. A kernel saved to numba's on-disk cache carries
+Why not ``np.sort``, ``np.argsort`` or ``np.searchsorted`` inside a kernel:
+numba builds their helpers from factories (``numba.misc.quicksort``: one
+closure for sort, one for argsort, ...; ``_searchsorted``: one per side)
+whose machine-code names differ only by a counter of the process that
+compiled them. A kernel saved to numba's on-disk cache carries
 its helpers under those names, with weak linkage. Loaded into a process that
 compiled its own helpers in another order, a name can denote the other
 closure there, and the linker binds the kernel to it: ``np.argsort`` then
 returns the sorted *values* as indices, and the kernel reads far out of
 range (a segmentation fault, now and then, depending on which process wrote
-the cache; ``tests/project/test_kernels.py`` reproduces it and checks that no
-kernel carries such a helper). Functions defined here have one definition
-each, so a name always denotes the same code.
+the cache; ``scripts/numba_cache_collision.py`` reproduces it, and
+``tests/project/test_kernels.py`` checks that no kernel carries such a
+helper). Functions defined here have one definition each, so a name always
+denotes the same code.
 """
 
 from numba import njit
 
-__all__ = ["sort_range", "sort_pairs"]
+__all__ = ["search_left", "sort_range", "sort_pairs"]
 
 _SMALL = 16  # ranges this short: insertion sort
 
@@ -72,7 +74,7 @@ def _heapsort(keys, payload, paired, lo, hi):
 
 @njit(cache=True, nogil=True)
 def _introsort(keys, payload, paired, lo, hi):
-    """Quicksort (median of three, Hoare partition) on an explicit stack; heapsort past 2 log2(n) levels."""
+    """Quicksort (median of three, Hoare partition) on an explicit stack; heapsort past 2 + 2 floor(log2 n) levels."""
     n = hi - lo
     depth_limit = 2
     while n > 1:
@@ -128,3 +130,16 @@ def sort_pairs(keys, payload, lo, hi):
         _insertion(keys, payload, True, lo, hi)
     else:
         _introsort(keys, payload, True, lo, hi)
+
+
+@njit(cache=True, nogil=True, inline="always")
+def search_left(keys, value):
+    """The first i with ``keys[i] >= value`` in ascending ``keys``, else ``len(keys)`` (``np.searchsorted``, left)."""
+    lo, hi = 0, len(keys)
+    while lo < hi:
+        middle = (lo + hi) // 2
+        if keys[middle] < value:
+            lo = middle + 1
+        else:
+            hi = middle
+    return lo

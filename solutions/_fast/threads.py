@@ -1,6 +1,8 @@
 """Run a ``nogil`` numba kernel over slices of an index range on every core.
 
-Every threaded path of the references goes through here, so that one switch
+Every threaded numba path of the references slices here (the k-d build runs
+its own pool, with :func:`worker_count` and :func:`threshold`; SciPy's
+``workers=-1`` calls are SciPy's), so that one switch
 (:func:`stress_slicing`) runs them all on many threads over tiny slices: the
 project's bounds-checked kernel run (``tests/project/test_kernels.py``) uses
 it to make the threads meet on small and degenerate inputs too.
