@@ -12,7 +12,7 @@
   submission staged and run in the sandbox.
 * :mod:`grading.staging` -- copies a submission's ``pcl_course/`` without
   following links: regular files only, with caps.
-* :mod:`grading.sandbox` and :mod:`grading.worker` -- the isolated worker
+* :mod:`grading.sandbox` -- the isolated worker
   process (bubblewrap, or a dedicated uid) and its plain-data protocol.
 * :mod:`grading.forbidden` -- the static scan for forbidden APIs.
 * :mod:`grading.checks` -- assertions with student-readable messages.

@@ -67,14 +67,14 @@ DIAGNOSIS_MAX_VALUES = 2_000_000
 # TEST_TIMEOUT), within Gradescope's default limit of 10 minutes.
 SUBMISSION_BUDGET = 480.0
 
-# -- the worker process (grading/sandbox.py) ----------------------------------
+# -- the worker process (grading/sandbox/) ----------------------------------
 MEMORY_LIMIT = 4 * 1024**3  # bytes of address space of one worker
 CPU_LIMIT = 600  # CPU seconds for a worker's whole life
 PROCESS_LIMIT = 256  # processes of the sandbox user (fork bombs)
 FILE_SIZE_LIMIT = 256 * 1024**2  # bytes of any one file the worker writes
 TMP_SIZE = 256 * 1024**2  # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
 # What the grader reads from a worker, every size checked before anything is allocated
-# (grading/sandbox.py): the grader's own memory stays bounded whatever a worker sends.
+# (grading/sandbox/): the grader's own memory stays bounded whatever a worker sends.
 ANSWER_LIMIT = 16 * 1024**2  # bytes of all the arrays of one answer (the reference's largest: 95 kB)
 HEADER_LIMIT = 1024**2  # bytes of one answer's JSON header
 MAX_ARRAYS = 4096  # arrays (and modified arguments) in one answer

@@ -74,7 +74,7 @@ def pytest_addoption(parser):
     )
     group.addoption("--results", default=None, metavar="FILE", help="write the results (Gradescope JSON) to FILE")
     group.addoption(
-        "--sandbox", action="store_true", help="run the implementation in a limited worker process (grading/sandbox.py)"
+        "--sandbox", action="store_true", help="run the implementation in a limited worker process (grading/sandbox/)"
     )
     group.addoption(
         "--call-timeout",

@@ -175,7 +175,7 @@ def stage(package_dir, into=None):
     package_dir = Path(package_dir)
     root = Path(into) if into is not None else Path(tempfile.mkdtemp(prefix="grading-staged-"))
     root.mkdir(parents=True, exist_ok=True)
-    root.chmod(0o700)  # the worker opens it to its own uid only (grading/sandbox.py)
+    root.chmod(0o700)  # the worker opens it to its own uid only (grading/sandbox/)
     parent_fd = _open_directory(str(package_dir.parent), None, "the submission's folder")
     try:
         info = os.stat(package_dir.name, dir_fd=parent_fd, follow_symlinks=False)

@@ -30,7 +30,7 @@ from _helpers import (
 )
 
 from grading import REPO_ROOT
-from grading.sandbox import _make_reachable, isolation
+from grading.sandbox import isolation, make_reachable
 
 UNPRIVILEGED_UID = 60450  # a grader run by a user without privileges (a student's laptop)
 needs_bubblewrap = pytest.mark.skipif(isolation().level != "bubblewrap", reason="needs bubblewrap")
@@ -53,8 +53,8 @@ def grade(submission, tmp_path, *args, as_user=None):
     results.parent.mkdir(exist_ok=True)
     kwargs = {}
     if as_user is not None:
-        _make_reachable(REPO_ROOT / ".venv")
-        _make_reachable(submission)
+        make_reachable(REPO_ROOT / ".venv")
+        make_reachable(submission)
         for path in (tmp_path, results.parent):
             os.chown(path, as_user, as_user)
         kwargs = {"user": as_user, "group": as_user, "extra_groups": []}

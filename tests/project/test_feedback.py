@@ -158,7 +158,7 @@ def test_batch_in_the_uid_mode_refuses_a_class_folder_the_sandbox_can_read(tmp_p
     classroom = tmp_path / "class"
     (classroom / "alice" / "pcl_course").mkdir(parents=True)
     os.chmod(classroom, 0o755)
-    sandbox._make_reachable(classroom)  # as a class folder under /home or /srv is
+    sandbox.make_reachable(classroom)  # as a class folder under /home or /srv is
     monkeypatch.setattr(sandbox, "isolation", lambda uid=None: sandbox.Isolation(sandbox.UID, 60530, "test"))
     with pytest.raises(SystemExit) as refused:
         cli.main(["batch", str(classroom), "--assignment", "lecture1", "--out", str(tmp_path / "out")])

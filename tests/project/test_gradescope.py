@@ -27,7 +27,7 @@ from _helpers import SUBPROCESS_BACKSTOP, load_results, reference_package, refer
 
 from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, REPO_ROOT
 from grading.leakcheck import find_leaks
-from grading.sandbox import _make_reachable
+from grading.sandbox import make_reachable
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="the dedicated-uid wall needs a root grader")
 
@@ -192,7 +192,7 @@ def test_a_hostile_submission_reads_writes_and_reaches_nothing(archive, tmp_path
     (root / "submission" / "metrics.py").write_text(
         SPY % {"readable": readable, "writable": writable, "port": server.getsockname()[1]}
     )
-    _make_reachable(root / "results")  # the folders above the mock /autograder: as open as / is
+    make_reachable(root / "results")  # the folders above the mock /autograder: as open as / is
     results, printed = run_autograder(root, namespaces=namespaces)
     assert results["score"] == 0
     outputs = [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance" and "SPY" in t["text"]]

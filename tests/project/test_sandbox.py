@@ -1,4 +1,4 @@
-"""The sandbox that runs submissions (grading/sandbox.py): hostile code loses
+"""The sandbox that runs submissions (grading/sandbox/): hostile code loses
 its own calls, never the grader's process, and sees neither the reference
 nor the tests."""
 
@@ -274,9 +274,9 @@ def test_without_namespaces_a_readable_course_is_not_isolation(tmp_path):
     secret = tmp_path / "course" / "tests"
     secret.mkdir(parents=True)
     (secret / "test_hidden.py").write_text("EXPECTED = 42\n")
-    from grading.sandbox import _make_reachable
+    from grading.sandbox import make_reachable
 
-    _make_reachable(secret)
+    make_reachable(secret)
     why = permission_wall(reserve_uid(), [secret])
     assert why is not None and f"can read {secret}" in why
 
@@ -288,9 +288,9 @@ def test_without_namespaces_the_dedicated_uid_reads_nothing_of_the_grader(tmp_pa
     course = tmp_path / "course"
     (course / "tests").mkdir(parents=True)
     (course / "tests" / "test_hidden.py").write_text("EXPECTED = 42\n")
-    from grading.sandbox import _make_reachable
+    from grading.sandbox import make_reachable
 
-    _make_reachable(course / "tests")  # the uid could reach it ...
+    make_reachable(course / "tests")  # the uid could reach it ...
     uid = reserve_uid()
     assert permission_wall(uid, [course / "tests"]) is not None
     os.chmod(course, 0o700)  # ... until the course folder is private, as on Gradescope
@@ -308,9 +308,9 @@ def test_without_namespaces_the_dedicated_uid_reads_nothing_of_the_grader(tmp_pa
             worker.call("evil", "read", (str(course / "tests" / "test_hidden.py"),), {})
     finally:
         worker.stop()
-    from grading.sandbox import _processes
+    from grading.sandbox import living_processes
 
-    assert not [p for p in _processes() if p[3] == uid], "the uid's processes outlive its worker"
+    assert not [p for p in living_processes() if p[3] == uid], "the uid's processes outlive its worker"
 
 
 def _real_uid_holders(uid):
@@ -405,11 +405,11 @@ def test_the_level_is_named_in_the_results_and_can_be_required(tmp_path):
 def test_a_grader_without_a_dedicated_uid_leaves_room_for_its_own_processes():
     """Without root, every worker shares the grader's uid: its process limit counts what runs already."""
     from grading import config
-    from grading.sandbox import _process_limit, _tasks_of_user
+    from grading.sandbox import process_limit, tasks_of_user
 
-    assert _process_limit(60_500) == config.PROCESS_LIMIT  # a dedicated uid starts with nothing
-    running = _tasks_of_user(os.getuid())
+    assert process_limit(60_500) == config.PROCESS_LIMIT  # a dedicated uid starts with nothing
+    running = tasks_of_user(os.getuid())
     assert running >= 1  # this test's own process, at least
     _, hard = resource.getrlimit(resource.RLIMIT_NPROC)
     expected = running + config.PROCESS_LIMIT
-    assert _process_limit(None) >= (expected if hard == resource.RLIM_INFINITY else min(expected, hard))
+    assert process_limit(None) >= (expected if hard == resource.RLIM_INFINITY else min(expected, hard))

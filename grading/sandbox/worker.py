@@ -1,16 +1,11 @@
-"""The worker process that runs a submission's code (started by grading/sandbox.py).
+"""The worker process that runs a submission's code (started by :mod:`grading.sandbox.client`).
 
-It is a standalone script: it imports nothing from the grader, and in the
-bubblewrap sandbox it is the only file of the grader's that exists. It reads
-call requests from the grader (length-prefixed pickles written by the trusted
-grader only), imports the submission's module, runs the function and answers
-with frames on a private copy of the original stdout: a JSON header, then
-one raw frame per array the header declares (its dtype and shape). The
-grader checks every declared size against its caps before it reads a byte
-of it, and accepts numeric dtypes only: nothing the worker sends is
-unpickled, decompressed or parsed as anything but JSON and raw numbers.
-Nothing goes through a file, so the grader never opens a path the worker
-names. Whatever the submission prints goes to stderr.
+It is a standalone script: it imports nothing from the grader but its wire
+protocol (``protocol.py`` beside it, loaded by path; the format is stated
+there), and in the bubblewrap sandbox these two are the only files of the
+grader's that exist. It reads call requests from the grader, imports the
+submission's module, runs the function and answers on a private copy of
+the original stdout. Whatever the submission prints goes to stderr.
 
 Each call is answered in two steps, so that the grader can tell a module
 that cannot be imported from a function that fails: first
@@ -38,12 +33,8 @@ import errno
 import importlib
 import json
 import os
-import pickle
-import struct
 import sys
 import traceback
-
-MAGIC = b"PCLW"
 
 
 class _ForbiddenImports:
@@ -101,26 +92,6 @@ def _check_network(site_packages):
     print(json.dumps({"closed": why_not is None, "why": why_not}))
 
 
-def _encode(value, arrays, np):
-    kind = type(value)
-    if kind is np.ndarray:
-        if value.dtype.kind not in "biufc" or value.dtype.fields is not None:
-            return {"t": "unsupported", "what": f"an ndarray of dtype {value.dtype}"}
-        arrays.append(np.ascontiguousarray(value))
-        return {"t": "ndarray", "k": len(arrays) - 1}
-    if isinstance(value, np.ndarray):
-        return {"t": "unsupported", "what": f"a subclass of numpy.ndarray ({kind.__module__}.{kind.__qualname__})"}
-    if kind in (bool, int, float, str) or value is None:
-        return {"t": "json", "v": value}
-    if isinstance(value, np.generic) and kind.__module__ == "numpy" and value.dtype.kind in "biufc":
-        return {"t": "npscalar", "dtype": value.dtype.str, "v": value.item()}
-    if kind in (tuple, list):
-        return {"t": kind.__name__, "items": [_encode(v, arrays, np) for v in value]}
-    if kind is dict and all(type(k) is str for k in value):
-        return {"t": "dict", "items": {k: _encode(v, arrays, np) for k, v in value.items()}}
-    return {"t": "unsupported", "what": f"an object of type {kind.__module__}.{kind.__qualname__}"}
-
-
 def _mutable_arguments(value, path, np):
     """(path, object) of every array and random generator inside the arguments."""
     if type(value) is np.ndarray:
@@ -169,30 +140,24 @@ def _failure(exc):
     }
 
 
-class _Protocol:
-    def __init__(self, stream):
-        self.stream = stream
+def _load_protocol():
+    """The wire protocol, from ``protocol.py`` beside this script (the sandbox has no ``grading``)."""
+    import importlib.util
 
-    def _frame(self, payload):
-        self.stream.write(MAGIC + struct.pack("<Q", len(payload)) + payload)
-
-    def send(self, header, arrays=()):
-        """The header (JSON), then each array's raw bytes in its own frame."""
-        if arrays:
-            header["arrays"] = [{"dtype": a.dtype.str, "shape": list(a.shape)} for a in arrays]
-        self._frame(json.dumps(header, allow_nan=True).encode("utf-8"))
-        for array in arrays:
-            self._frame(array.tobytes())
-        self.stream.flush()
+    path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "protocol.py")
+    spec = importlib.util.spec_from_file_location("_pcl_grading_protocol", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
-def _call(request, protocol, np):
+def _call(request, wire, sender, np):
     try:
         module = importlib.import_module(f"pcl_course.{request['module']}")
     except BaseException as exc:  # noqa: B902 -- SystemExit at import is an answer too
-        protocol.send({**_failure(exc), "phase": "import"})
+        sender.send({**_failure(exc), "phase": "import"})
         return
-    protocol.send({"imported": True})
+    sender.send({"imported": True})
     arguments = {"args": list(request["args"]), "kwargs": dict(request["kwargs"])}
     for path in request.get("read_only", ()):
         array = arguments
@@ -206,7 +171,7 @@ def _call(request, protocol, np):
             raise AttributeError(f"{request['module']}.py defines no function {request['function']}")
         result = function(*arguments["args"], **arguments["kwargs"])
         arrays = []
-        answer = {"ok": True, "value": _encode(result, arrays, np)}
+        answer = {"ok": True, "value": wire.encode(result, arrays)}
     except BaseException as exc:  # noqa: B902 -- KeyboardInterrupt and SystemExit are answers too
         arrays, answer = [], _failure(exc)
     modified = []
@@ -217,35 +182,33 @@ def _call(request, protocol, np):
             else:
                 modified.append({"path": path})
     answer["modified"] = modified
-    protocol.send(answer, arrays)
+    sender.send(answer, arrays)
 
 
 def main():
     if sys.argv[1] == "--check-network":
         return _check_network(sys.argv[2])
     site_packages, submission, forbidden, network = sys.argv[1], sys.argv[2], sys.argv[3].split(","), sys.argv[4]
-    protocol = _Protocol(os.fdopen(os.dup(1), "wb", buffering=0))
+    answers = os.fdopen(os.dup(1), "wb", buffering=0)
     os.dup2(2, 1)  # the submission's prints go to stderr, not into the protocol
     sys.stdout = sys.stderr
     requests = sys.stdin.buffer
     sys.path[:] = [p for p in sys.path if p and os.path.isdir(p)] + [site_packages]
+    wire = _load_protocol()  # imports numpy, from the environment's site-packages
+    sender = wire.Sender(answers)
     # Before the forbidden-import finder: pyseccomp is the grader's. Under bubblewrap the
     # network namespace is the wall already.
     why_not = close_network() if network != "namespace" else None
     if why_not is not None and network == "required":
-        protocol.send({"ready": False, "error": f"the network could not be closed: {why_not}"})
+        sender.send({"ready": False, "error": f"the network could not be closed: {why_not}"})
         return
     sys.meta_path.insert(0, _ForbiddenImports(forbidden))
     sys.path.insert(0, submission)
     import numpy as np
 
-    protocol.send({"ready": True})
-    while True:
-        header = requests.read(8)
-        if len(header) < 8:
-            return
-        request = pickle.loads(requests.read(struct.unpack("<Q", header)[0]))  # written by the grader
-        _call(request, protocol, np)
+    sender.send({"ready": True})
+    while (request := wire.read_request(requests)) is not None:
+        _call(request, wire, sender, np)
 
 
 if __name__ == "__main__":

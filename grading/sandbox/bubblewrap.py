@@ -1,0 +1,228 @@
+"""The bubblewrap command that runs a worker: its binds, masks and environment.
+
+The sandbox's filesystem is built from nothing: read-only binds of the
+interpreter (``sys.base_prefix``), the system libraries and the
+environment's site-packages, with every forbidden package and every
+editable-install file masked (:func:`masked_paths`, also what the uid level
+bars with ACLs); the staged submission, the worker script and its wire
+protocol; a size-capped tmpfs for ``/tmp`` (also ``HOME``), the only
+writable place; its own ``/proc`` and a minimal ``/dev``. No repository,
+``.git``, tests, solutions, ``grading/`` or other submission exists there.
+"""
+
+import os
+import subprocess
+import sys
+from functools import cache
+from pathlib import Path
+
+from grading import config
+
+WORKER = Path(__file__).with_name("worker.py")  # the script a worker runs
+PROTOCOL = Path(__file__).with_name("protocol.py")  # the wire format, beside it in every staging folder
+WORKER_FILES = (WORKER, PROTOCOL)
+
+# Paths inside the bubblewrap sandbox.
+SANDBOX_PYTHON_ROOT = "/python"
+SANDBOX_SITE = "/sandbox/site-packages"
+SANDBOX_WORKER = "/sandbox/worker.py"
+SANDBOX_PROTOCOL = "/sandbox/protocol.py"
+SANDBOX_SUBMISSION = "/submission"
+
+
+def site_packages():
+    """The environment's site-packages folder (resolved)."""
+    import sysconfig
+
+    return Path(sysconfig.get_paths()["purelib"]).resolve()
+
+
+def python_executable():
+    """The interpreter's real path and its path relative to ``sys.base_prefix``."""
+    executable = Path(sys.executable).resolve()
+    base = Path(sys.base_prefix).resolve()
+    try:
+        return executable, executable.relative_to(base)
+    except ValueError:
+        return executable, None
+
+
+def _site_dirs(root):
+    """Folders under ``root`` that Python may import packages from."""
+    patterns = (
+        "lib/python3*/site-packages",
+        "lib/python3*/dist-packages",
+        "lib/python3/dist-packages",
+        "local/lib/python3*/site-packages",
+        "local/lib/python3*/dist-packages",
+        "python3*/site-packages",
+        "python3*/dist-packages",
+        "python3/dist-packages",
+    )
+    found = {root} if root.name in ("site-packages", "dist-packages") else set()
+    for pattern in patterns:
+        found.update(p for p in root.glob(pattern) if p.is_dir())
+    return sorted(found)
+
+
+def _installed_paths(dist_info):
+    """The paths a distribution installed, relative to its site folder (first column of its RECORD)."""
+    try:
+        record = (dist_info / "RECORD").read_text(errors="replace")
+    except OSError:
+        return set()
+    paths = (line.split(",", 1)[0] for line in record.splitlines())
+    return {path for path in paths if path and not path.startswith("..")}
+
+
+def _masked_entries(site):
+    """Entries of a site folder the submission must not see: the forbidden
+    packages (their modules, compiled libraries, bundled ``.libs`` and
+    metadata) and the editable install's files, which point back into the
+    course repository."""
+    forbidden = set(config.FORBIDDEN_PACKAGES)
+    masked = set()
+    for entry in site.iterdir():
+        stem = entry.name.split(".")[0].split("-")[0]
+        if entry.name.startswith(("pcl_course", "pcl-course")) and entry.name.endswith(".dist-info"):
+            # This course's own editable install: every file it wrote points back into the repository.
+            masked.add(entry)
+            outside = [path for path in _installed_paths(entry) if not path.startswith(f"{entry.name}/")]
+            masked.update(site / path for path in outside if (site / path).is_file())
+        elif stem in forbidden or entry.name.startswith("__editable__") or entry.name.endswith(".egg-link"):
+            masked.add(entry)
+        elif entry.name.endswith(".dist-info"):
+            # A distribution named otherwise (scikit_learn) that installs a forbidden module (sklearn).
+            tops = {path.split("/", 1)[0] for path in _installed_paths(entry)}
+            if {top.split(".")[0] for top in tops} & forbidden:
+                masked.update(site / top for top in tops if (site / top).exists() or (site / top).is_symlink())
+    return sorted(masked)
+
+
+def _system_roots():
+    """The system's library folders that exist here (bound into the sandbox as they are)."""
+    return [path for path in ("/usr/lib", "/usr/lib64", "/usr/lib32") if Path(path).is_dir()]
+
+
+def _import_roots():
+    """(host folder, sandbox folder) of every folder the sandbox could import from."""
+    base = Path(sys.base_prefix).resolve()
+    return [(Path(p), p) for p in _system_roots()] + [(base, SANDBOX_PYTHON_ROOT), (site_packages(), SANDBOX_SITE)]
+
+
+@cache
+def masked_paths():
+    """Every entry, in every folder the sandbox could import from, that a submission must not
+    reach: the forbidden packages and the editable install's files (:func:`_masked_entries`)."""
+    found = []
+    for root, _ in _import_roots():
+        for site_dir in _site_dirs(root):
+            found += [entry for entry in _masked_entries(site_dir) if entry not in found]
+    return tuple(found)
+
+
+@cache
+def _environment_binds():
+    """The options that bind the interpreter, the system libraries and the
+    site-packages, with every forbidden package masked: the same for every
+    worker of this process, and slow to find (every distribution's metadata
+    is read), so found once."""
+    options = []
+    for source in _system_roots():
+        options += ["--ro-bind", source, source, "--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
+    options += ["--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache"]
+    roots = _import_roots()
+    for source, target in roots[len(_system_roots()) :]:
+        options += ["--ro-bind", str(source), target]
+    # Mask the forbidden packages wherever the sandbox could import them from.
+    for entry in masked_paths():
+        source_root, target_root = next((s, t) for s, t in roots if s in entry.parents)
+        target = f"{target_root}/{entry.relative_to(source_root)}"
+        if entry.is_dir() and not entry.is_symlink():
+            options += ["--tmpfs", target]
+        else:
+            options += ["--ro-bind", "/dev/null", target]
+    return tuple(options)
+
+
+def bubblewrap_command(staged_root, python_argv_tail):
+    """The ``bwrap`` command line that runs the worker on a staged submission."""
+    executable, relative = python_executable()
+    command = [
+        "bwrap",
+        "--unshare-all",
+        "--unshare-user",
+        "--disable-userns",
+        "--die-with-parent",
+        "--new-session",
+        "--clearenv",
+        "--hostname",
+        "sandbox",
+        "--cap-drop",
+        "ALL",
+        *_environment_binds(),
+    ]
+    command += [
+        "--ro-bind",
+        str(staged_root / "pcl_course"),
+        f"{SANDBOX_SUBMISSION}/pcl_course",
+        "--ro-bind",
+        str(staged_root / WORKER.name),
+        SANDBOX_WORKER,
+        "--ro-bind",
+        str(staged_root / PROTOCOL.name),
+        SANDBOX_PROTOCOL,
+        "--proc",
+        "/proc",
+        "--dev",
+        "/dev",
+        "--size",
+        str(config.TMP_SIZE),
+        "--tmpfs",
+        "/tmp",
+        "--chdir",
+        "/tmp",
+        # Last, after every bind: the root (a tmpfs of bubblewrap's, in RAM and uncapped)
+        # read-only, so that the capped /tmp is the only place the submission can write.
+        "--remount-ro",
+        "/",
+    ]
+    for key, value in environment("/tmp").items():
+        command += ["--setenv", key, value]
+    python = f"{SANDBOX_PYTHON_ROOT}/{relative}" if relative is not None else str(executable)
+    return [*command, "--", python, "-I", "-S", SANDBOX_WORKER, SANDBOX_SITE, SANDBOX_SUBMISSION, *python_argv_tail]
+
+
+def spawn(command, **kwargs):
+    """Start ``command``; a ``bwrap`` command gets its arguments through a pipe
+    (``--args FD``), so that no path of the grader's shows in the sandbox's
+    ``/proc/1/cmdline``."""
+    if command[0] != "bwrap":
+        return subprocess.Popen(command, **kwargs)
+    end = command.index("--")  # the options go through the pipe, the sandbox's own command line stays
+    read, write = os.pipe()
+    try:
+        os.write(write, b"".join(arg.encode() + b"\0" for arg in command[1:end]))
+    finally:
+        os.close(write)
+    try:
+        return subprocess.Popen(["bwrap", "--args", str(read), *command[end:]], pass_fds=(read,), **kwargs)
+    finally:
+        os.close(read)
+
+
+def environment(home):
+    """The environment variables of a worker whose home (and temporary folder) is ``home``."""
+    return {
+        "PATH": "/usr/bin:/bin",
+        "HOME": home,
+        "TMPDIR": home,
+        "LANG": "C.UTF-8",
+        "OMP_NUM_THREADS": "1",
+        "OPENBLAS_NUM_THREADS": "1",
+        "MKL_NUM_THREADS": "1",
+        "NUMBA_NUM_THREADS": "1",
+        "NUMBA_CACHE_DIR": f"{home}/numba",
+        "OPEN3D_DISABLE_WEB_VISUALIZER": "true",
+        "MPLBACKEND": "Agg",
+    }

@@ -1,0 +1,457 @@
+"""The client of a worker process: :class:`Worker` runs a staged submission's functions.
+
+The grading process (which runs the tests and decides the score) never
+imports the submission. Each call is sent to a worker process
+(``worker.py``) that runs at the strongest level of isolation the machine
+allows (:func:`grading.sandbox.walls.isolation`), and answers with plain
+data only (:mod:`grading.sandbox.protocol`). A call is limited by the
+worker's CPU time (every process and thread of it), with a wall-clock
+backstop, so that the machine's load changes no mark.
+
+A call that times out, crashes the worker, leaves a thread or a process
+running, or returns something that is not plain data fails that call (and
+so that test); the next call starts a fresh worker. A module that cannot be
+imported (it raises, exits, crashes or hangs at import) is detected once:
+every later call into it fails at once with the same message.
+"""
+
+import builtins
+import os
+import select
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from grading import config
+from grading.errors import SandboxError
+from grading.sandbox import protocol
+from grading.sandbox.bubblewrap import (
+    WORKER_FILES,
+    bubblewrap_command,
+    environment,
+    python_executable,
+    site_packages,
+    spawn,
+)
+from grading.sandbox.processes import become_subreaper, kill_uid, living_processes, preexec, reap, stat_of
+from grading.sandbox.walls import BUBBLEWRAP, isolation, remove_files_of
+
+
+class Worker:
+    """One worker process for one staged submission; restarted after any failure.
+
+    Parameters
+    ----------
+    staged_root : path
+        The staging folder (:class:`grading.staging.StagedSubmission` root):
+        its ``pcl_course/`` is the submission.
+    timeout : float
+        CPU seconds of one call, its module's import included, counted over
+        every process and thread of the worker: a busy machine does not
+        change a mark. ``config.CALL_WALL_FACTOR`` times as many wall-clock
+        seconds stop a call that waits without computing.
+    uid : int, optional
+        The preferred dedicated sandbox uid (when the grader is root).
+    level : Isolation, optional
+        The isolation to use (default: :func:`isolation`'s, the strongest).
+    """
+
+    def __init__(self, staged_root, timeout=config.CALL_TIMEOUT, uid=None, level=None):
+        self.staged_root = Path(staged_root).resolve()
+        self.timeout = timeout
+        self.process = None
+        self.work = None
+        self.isolation = level if level is not None else isolation(uid)
+        self.uid = self.isolation.uid
+        self.broken = {}  # module -> why it cannot be imported
+        self.last_modified = []
+        self.known_pids = None  # the worker's processes at the last count (None: not counted yet)
+        if self.uid is not None:
+            remove_files_of(self.uid)  # what an earlier grader, killed, may have left
+
+    # -- process management ---------------------------------------------------
+
+    def _command(self):
+        # Bubblewrap's empty network namespace is the wall (its sandbox has no ldconfig for
+        # libseccomp anyway); without one the seccomp filter is, required as a dedicated uid.
+        if self.isolation.level == BUBBLEWRAP:
+            network = "namespace"
+        else:
+            network = "required" if self.uid is not None else "optional"
+        tail = [",".join(config.FORBIDDEN_PACKAGES), network]
+        if self.isolation.level == BUBBLEWRAP:
+            return bubblewrap_command(self.staged_root, tail), {}
+        python = [
+            str(python_executable()[0]),
+            "-I",
+            "-S",
+            str(self.staged_root / WORKER_FILES[0].name),
+            str(site_packages()),
+            str(self.staged_root),
+            *tail,
+        ]
+        return python, environment(self.work)
+
+    def start(self):
+        become_subreaper()
+        for source in WORKER_FILES:  # the worker script and its wire protocol, nothing else of the grader's
+            shutil.copy(source, self.staged_root / source.name)
+            (self.staged_root / source.name).chmod(0o644)
+        if self.uid is not None:
+            # Readable by this worker's uid (Python lists the folders it imports
+            # from), by no other sandbox uid: a classmate's is out of reach.
+            os.chown(self.staged_root, 0, self.uid)
+            os.chmod(self.staged_root, 0o750)
+        self.work = tempfile.mkdtemp(prefix="grading-home-")  # HOME of the uid and none levels
+        if self.uid is not None:
+            os.chown(self.work, self.uid, self.uid)
+        command, env = self._command()
+        self.known_pids = None  # a restarted worker's processes are new
+        self.stderr = tempfile.TemporaryFile()
+        self.process = spawn(
+            command,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=self.stderr,
+            env=env,
+            cwd=self.work,
+            preexec_fn=preexec(self.uid),
+        )
+        try:
+            header = self._read_header(_Deadline(self, max(self.timeout, 60.0)))
+            if not header.get("ready"):
+                raise SandboxError(str(header.get("error") or "the worker did not start"), kind=GARBLED)
+        except SandboxError as exc:
+            self.stop()
+            raise SandboxError(f"the sandbox could not start: {exc}", kind=exc.kind) from None
+        self.baseline = self._tasks()
+
+    def stop(self):
+        if self.process is not None:
+            try:
+                os.killpg(self.process.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+            self.process.wait()
+            self.process = None
+            if self.uid is not None:
+                kill_uid(self.uid)
+            deadline = time.monotonic() + 5.0
+            while time.monotonic() < deadline:
+                reap()
+                if not self._leftovers():
+                    break
+                time.sleep(0.01)
+        if self.work:
+            shutil.rmtree(self.work, ignore_errors=True)
+            self.work = None
+
+    def close(self):
+        """Stop the worker and remove every file its uid left anywhere writable."""
+        self.stop()
+        if self.uid is not None:
+            remove_files_of(self.uid)
+
+    def _leftovers(self):
+        if self.uid is not None:
+            return any(p[3] == self.uid for p in living_processes())
+        return False
+
+    def _pids(self):
+        """The worker's processes: those of its uid, else its process and descendants."""
+        processes = living_processes()
+        if self.uid is not None:
+            return [p[0] for p in processes if p[3] == self.uid]
+        children = {}
+        for pid, parent, _, _ in processes:
+            children.setdefault(parent, []).append(pid)
+        found, stack = [], [self.process.pid]
+        while stack:
+            pid = stack.pop()
+            found.append(pid)
+            stack.extend(children.get(pid, ()))
+        return found
+
+    def _tasks(self):
+        """How many threads the worker runs, over all its processes (remembered for :meth:`cpu_seconds`)."""
+        self.known_pids = self._pids()
+        return sum(stat_of(pid)[0] for pid in self.known_pids)
+
+    def cpu_seconds(self, pids=None):
+        """CPU seconds the worker's processes (``pids``, else all found now) have used so far,
+        their reaped children included."""
+        return sum(stat_of(pid)[1] for pid in (self._pids() if pids is None else pids))
+
+    def _stderr_tail(self):
+        """The last lines the worker wrote to stderr; only the file's end is read."""
+        size = self.stderr.seek(0, os.SEEK_END)
+        self.stderr.seek(max(0, size - config.STDERR_TAIL_BYTES))
+        text = self.stderr.read(config.STDERR_TAIL_BYTES).decode("utf-8", "replace").strip().splitlines()
+        return "\n".join(line[:200] for line in text[-5:])
+
+    # -- calls ------------------------------------------------------------------
+
+    def call(self, module, function, args, kwargs):
+        """Call ``pcl_course.<module>.<function>(*args, **kwargs)`` in the worker.
+
+        The arguments here are never changed: the worker works on its own
+        copies. Returns the answer; :attr:`last_modified` then holds the
+        paths of the arguments the call modified in place (``["args", 0]``
+        is the first positional one, ``["kwargs", "name"]`` a keyword one).
+        A random generator among the arguments draws on from where the call
+        left it.
+        """
+        self.last_modified = []
+        if module in self.broken:
+            raise SandboxError(self.broken[module], kind=IMPORT)
+        if self.process is None or self.process.poll() is not None:
+            self.stop()
+            self.start()
+        try:
+            result = self._call(module, function, args, kwargs)
+        except BaseException as exc:
+            from_submission = getattr(exc, "from_submission", False)
+            stray = self._stray_tasks() if self.process is not None else False
+            if not from_submission or stray:
+                self.stop()  # a timed-out, broken or forking worker never serves another call
+            if from_submission and stray:
+                raise SandboxError(STRAY_MESSAGE, kind=STRAY) from None
+            raise
+        if self._stray_tasks():
+            self.stop()
+            raise SandboxError(STRAY_MESSAGE, kind=STRAY)
+        return result
+
+    def _stray_tasks(self):
+        """Whether the worker runs more threads or processes than when it started.
+
+        A thread that was joined before the call returned may still be
+        leaving the kernel's task list (``Thread.join`` returns just before
+        the thread's last instructions, and a busy machine may not schedule
+        them at once): only what outlives a grace period is stray.
+        """
+        if self.process is None:
+            return False
+        deadline = time.monotonic() + STRAY_GRACE_SECONDS
+        while self._tasks() > self.baseline:
+            if time.monotonic() > deadline:
+                return True
+            time.sleep(0.005)
+        return False
+
+    def _call(self, module, function, args, kwargs):
+        arguments = {"args": list(args), "kwargs": dict(kwargs)}
+        read_only = [path for path, value in _arrays(arguments, []) if not value.flags.writeable]
+        request = {"module": module, "function": function, "args": args, "kwargs": kwargs, "read_only": read_only}
+        deadline = _Deadline(self, self.timeout)
+        try:
+            protocol.write_request(self.process.stdin, request)
+        except BrokenPipeError:
+            raise SandboxError(self._death_message(), kind=DIED) from None
+        try:
+            header = self._read_header(deadline)
+        except SandboxError as exc:
+            self.broken[module] = (
+                f"{module}.py cannot be imported: {exc}; every test of {module}.py fails until its import is fixed"
+            )
+            raise SandboxError(self.broken[module], kind=IMPORT) from None
+        if not header.get("imported"):
+            what = (
+                f"raised {header.get('type')}: {header.get('message')}"
+                if header.get("phase") == "import" and "type" in header
+                else "the worker's answer was garbled"
+            )
+            where = f" (at {header['where']})" if isinstance(header.get("where"), str) and header["where"] else ""
+            self.broken[module] = (
+                f"{module}.py cannot be imported: it {what}{where}; every test of "
+                f"{module}.py fails until its import is fixed"
+            )
+            raise SandboxError(self.broken[module], kind=IMPORT)
+        answer = self._read_header(deadline)
+        arrays = self._read_arrays(answer.get("arrays", []), deadline)
+        self.last_modified = _modified_paths(arguments, answer.get("modified", []))
+        if answer.get("ok") is not True:
+            if not isinstance(answer.get("type"), str):
+                raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+            exc = _exception(answer)
+            exc.from_submission = True  # the function raised: the worker itself is fine
+            exc.modified = self.last_modified
+            raise exc
+        return _unwrapped(protocol.decode, answer.get("value"), arrays)
+
+    # -- reading the worker's frames, every size checked before it is read ---------
+
+    def _wait_readable(self, deadline):
+        stream = self.process.stdout.fileno()
+        while True:
+            remaining = deadline.wall - time.monotonic()
+            if remaining <= 0:
+                raise SandboxError(
+                    f"timed out: the call waited for more than {deadline.wall_seconds:g} s (wall clock)", kind=TIMEOUT
+                )
+            ready, _, _ = select.select([stream], [], [], min(remaining, CPU_POLL_SECONDS))
+            if ready:
+                return stream
+            if self.cpu_seconds() - deadline.cpu_start > deadline.cpu_seconds:
+                raise SandboxError(
+                    f"timed out: the call used more than {deadline.cpu_seconds:g} s of CPU time", kind=TIMEOUT
+                )
+
+    def _read_exactly(self, size, deadline):
+        """``size`` bytes of the worker's stdout, into a buffer allocated once (``size`` is checked already)."""
+        buffer = bytearray(size)
+        view, got = memoryview(buffer), 0
+        while got < size:
+            stream = self._wait_readable(deadline)
+            count = os.readv(stream, [view[got:]])
+            if count == 0:
+                raise SandboxError(self._death_message(), kind=DIED)
+            got += count
+        return buffer
+
+    def _read_header(self, deadline):
+        return _unwrapped(protocol.read_header, lambda size: self._read_exactly(size, deadline), config.HEADER_LIMIT)
+
+    def _read_arrays(self, declared, deadline):
+        """The arrays the answer's header declares: numeric dtypes only, all sizes checked first."""
+        return _unwrapped(
+            protocol.read_arrays,
+            lambda size: self._read_exactly(size, deadline),
+            declared,
+            config.ANSWER_LIMIT,
+            config.MAX_ARRAYS,
+        )
+
+    def _death_message(self):
+        code = self.process.wait()
+        how = f"killed by signal {-code}" if code < 0 else f"exit status {code}"
+        hint = ""
+        if code in (-signal.SIGKILL, -signal.SIGXCPU, -signal.SIGXFSZ):
+            hint = " (a resource limit: memory, CPU time, file size or processes)"
+        tail = self._stderr_tail()
+        return f"the submission's process died ({how}){hint}" + (f"; its last output:\n{tail}" if tail else "")
+
+
+CPU_POLL_SECONDS = 0.25  # how often a waiting call's CPU time is read
+STRAY_GRACE_SECONDS = 2.0  # how long a thread or process past the call's end may take to finish exiting
+STRAY_MESSAGE = "the submission left processes or threads running after the call returned"
+
+# The kinds of sandbox failure (SandboxError.kind): what a hidden test may say of one.
+TIMEOUT, DIED, GARBLED, TOO_LARGE = (
+    SandboxError.TIMEOUT,
+    SandboxError.DIED,
+    SandboxError.GARBLED,
+    SandboxError.TOO_LARGE,
+)
+UNSUPPORTED, IMPORT, STRAY = SandboxError.UNSUPPORTED, SandboxError.IMPORT, SandboxError.STRAY
+GENERATOR, RAISED = SandboxError.GENERATOR, SandboxError.RAISED
+
+
+def _unwrapped(read, *args):
+    """``read(*args)``, a malformed answer raised as the :class:`SandboxError` of its kind."""
+    try:
+        return read(*args)
+    except protocol.ProtocolError as exc:
+        raise SandboxError(str(exc), kind=exc.kind) from None
+
+
+@dataclass
+class _Deadline:
+    """A call's limits: CPU seconds of the worker from now, and a wall-clock backstop."""
+
+    worker: Worker
+    cpu_seconds: float
+
+    def __post_init__(self):
+        # Between calls the worker runs exactly the processes counted after the last one (any more
+        # would have stopped it): no need to walk /proc again here, the hot path of every call.
+        self.cpu_start = self.worker.cpu_seconds(self.worker.known_pids)
+        self.wall_seconds = self.cpu_seconds * config.CALL_WALL_FACTOR
+        self.wall = time.monotonic() + self.wall_seconds
+
+
+def _arrays(value, path):
+    """(path, array) of every ndarray inside nested tuples, lists and dicts."""
+    if type(value) is np.ndarray:
+        yield path, value
+    elif type(value) in (tuple, list):
+        for i, item in enumerate(value):
+            yield from _arrays(item, [*path, i])
+    elif type(value) is dict:
+        for key, item in value.items():
+            yield from _arrays(item, [*path, key])
+
+
+def _modified_paths(arguments, modified):
+    """The paths of the arguments the call modified, as the worker names them; a random
+    generator takes the new state the worker sent (checked: one its own stream reaches)."""
+    if not isinstance(modified, list) or len(modified) > config.MAX_ARRAYS:
+        raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+    paths = []
+    for change in modified:
+        try:
+            target = arguments
+            for step in change["path"]:
+                target = target[step]
+        except (KeyError, IndexError, TypeError):
+            raise SandboxError("the worker's answer was garbled", kind=GARBLED) from None
+        if isinstance(target, np.random.Generator):
+            set_generator_state(target, change.get("state"))
+        elif type(target) is not np.ndarray:
+            raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+        paths.append(list(change["path"]))
+    return paths
+
+
+def set_generator_state(generator, state):
+    """Give ``generator`` a state the worker sent back, if its own stream could reach it.
+
+    PCG64's state is a position on one stream (``inc``): any 128-bit
+    position on the same stream is one the generator reaches by drawing,
+    any other (another ``inc``, another bit generator, a malformed state)
+    is refused, so that no submission hands the grader a stream of its
+    choosing.
+    """
+    current = generator.bit_generator.state
+    ok = (
+        isinstance(state, dict)
+        and set(state) == set(current)
+        and state.get("bit_generator") == current["bit_generator"] in ("PCG64", "PCG64DXSM")
+        and isinstance(state.get("state"), dict)
+        and set(state["state"]) == {"state", "inc"}
+        and state["state"]["inc"] == current["state"]["inc"]
+        and type(state["state"]["state"]) is int
+        and 0 <= state["state"]["state"] < 2**128
+        and state.get("has_uint32") in (0, 1)
+        and type(state.get("uinteger")) is int
+        and 0 <= state["uinteger"] < 2**32
+    )
+    if not ok:
+        raise SandboxError(
+            "the random generator came back in a state its own stream cannot reach: draw from it, never set it",
+            kind=GENERATOR,
+        )
+    generator.bit_generator.state = state
+
+
+def _exception(answer):
+    kind = str(answer.get("type"))[: config.MAX_TEXT]
+    message = str(answer.get("message"))[: config.MAX_TEXT]
+    where = answer.get("where") if isinstance(answer.get("where"), str) else ""
+    where = where[: config.MAX_TEXT]
+    shown = f" (at {where})" if where else ""
+    cls = getattr(builtins, kind, None) if answer.get("builtin") is True else None
+    if isinstance(cls, type) and issubclass(cls, Exception):
+        try:
+            exc = cls(message)
+        except TypeError:  # a builtin whose constructor wants more (UnicodeDecodeError, ...)
+            return SandboxError(f"raised {kind}: {message}{shown}", kind=RAISED)
+        exc.where = where
+        return exc
+    return SandboxError(f"raised {kind}: {message}{shown}", kind=RAISED)

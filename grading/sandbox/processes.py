@@ -1,0 +1,166 @@
+"""The worker's processes: their limits, their accounting, and killing what they leave.
+
+Read from ``/proc`` with plain ``os`` calls (some of these run after every
+graded call): who a process belongs to, how many threads a user runs, how
+much CPU time a worker used. A worker runs in its own session under
+``RLIMIT_AS``, ``RLIMIT_CPU``, ``RLIMIT_FSIZE`` and, as its own user,
+``RLIMIT_NPROC`` (:func:`preexec`).
+"""
+
+import os
+import re
+import resource
+import signal
+import sys
+import time
+
+from grading import config
+
+
+def tasks_of_user(uid):
+    """How many processes and threads the real user ``uid`` has now (what ``RLIMIT_NPROC`` counts)."""
+    count = 0
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            if os.stat(entry.path).st_uid == uid:
+                count += len(os.listdir(f"{entry.path}/task"))
+        except OSError:  # gone since the scan
+            continue
+    return count
+
+
+def process_limit(uid):
+    """``RLIMIT_NPROC`` for a worker: :data:`config.PROCESS_LIMIT` more tasks than its user has now.
+
+    A dedicated uid has none, so its limit is ``PROCESS_LIMIT``. A grader that
+    is not root shares its own uid with its other workers, its test runner
+    and the rest of the user's session: a fixed limit would let one
+    submission's fork bomb stop a neighbour's worker from starting, or
+    refuse a busy session its first worker at all.
+    """
+    if uid is not None or not sys.platform.startswith("linux"):
+        return config.PROCESS_LIMIT
+    limit = tasks_of_user(os.getuid()) + config.PROCESS_LIMIT
+    _, hard = resource.getrlimit(resource.RLIMIT_NPROC)
+    return limit if hard == resource.RLIM_INFINITY else min(limit, hard)
+
+
+def preexec(uid):
+    """Run in the worker's process before exec: its own session, limits, the sandbox uid."""
+    nproc = process_limit(uid) if uid is not None or os.geteuid() != 0 else None
+
+    def apply():
+        os.setsid()  # its own process group: killed as a whole, forks included
+        for limit, value in (
+            (resource.RLIMIT_AS, config.MEMORY_LIMIT),
+            (resource.RLIMIT_CPU, config.CPU_LIMIT),
+            (resource.RLIMIT_FSIZE, config.FILE_SIZE_LIMIT),
+            (resource.RLIMIT_CORE, 0),
+        ):
+            try:
+                resource.setrlimit(limit, (value, value))
+            except (OSError, ValueError):
+                if sys.platform.startswith("linux"):
+                    raise
+                # macOS refuses some limits (RLIMIT_AS): never isolated there anyway
+        if uid is not None:
+            os.setgroups([])
+            os.setgid(uid)
+            os.setuid(uid)
+        if nproc is not None:
+            resource.setrlimit(resource.RLIMIT_NPROC, (nproc, nproc))
+
+    return apply
+
+
+def become_subreaper():
+    """Adopt the worker's orphans (PR_SET_CHILD_SUBREAPER) so that they can be
+    reaped here: a fork bomb's killed children would otherwise stay zombies of
+    PID 1, which on some machines never reaps them, and use up RLIMIT_NPROC."""
+    import ctypes
+
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)  # PR_SET_CHILD_SUBREAPER
+    except (OSError, AttributeError):
+        pass
+
+
+_STATUS_FIELDS = re.compile(rb"^(State|PPid|Uid|NSpgid):\s*(\S+)", re.MULTILINE)  # Uid: the real one first
+
+
+def living_processes():
+    """(pid, parent pid, process group, real uid) of every living process (no zombies).
+
+    From /proc/PID/status, whose ``Uid:`` line holds the real uid: the owner
+    of a process's /proc files is root once it makes itself non-dumpable
+    (``prctl(PR_SET_DUMPABLE, 0)``), which would hide it from
+    :func:`kill_uid`. Called after every graded call, so plain ``os`` calls
+    rather than ``pathlib``. The status file escapes newlines in the
+    process's name, so a name cannot forge a line.
+    """
+    found = []
+    with os.scandir("/proc") as entries:
+        for entry in entries:
+            if not entry.name.isdigit():
+                continue
+            try:
+                handle = os.open(f"/proc/{entry.name}/status", os.O_RDONLY)
+                try:
+                    status = os.read(handle, 1 << 16)
+                finally:
+                    os.close(handle)
+                fields = dict(_STATUS_FIELDS.findall(status, status.find(b"\n")))  # after the Name line
+                state, parent, uid = fields[b"State"], int(fields[b"PPid"]), int(fields[b"Uid"])
+                group = int(fields.get(b"NSpgid", -1))
+            except (OSError, KeyError, IndexError, ValueError):
+                continue
+            if state != b"Z":
+                found.append((int(entry.name), parent, group, uid))
+    return found
+
+
+def reap():
+    try:
+        while os.waitpid(-1, os.WNOHANG)[0] > 0:
+            pass
+    except ChildProcessError:
+        pass
+
+
+def kill_uid(uid):
+    """Kill every process of ``uid``: a child that takes that uid and calls ``kill(-1, SIGKILL)``."""
+    for _ in range(50):
+        if not any(p[3] == uid for p in living_processes()):
+            return
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child
+            try:
+                os.setgroups([])
+                os.setgid(uid)
+                os.setuid(uid)
+                os.kill(-1, signal.SIGKILL)
+            finally:
+                os._exit(0)
+        os.waitpid(pid, 0)
+        time.sleep(0.02)
+        reap()
+
+
+_CLOCK_TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
+
+
+def stat_of(pid):
+    """(threads, CPU seconds with reaped children) of a process, from /proc/PID/stat; (0, 0) once it is gone."""
+    try:
+        handle = os.open(f"/proc/{pid}/stat", os.O_RDONLY)
+        try:
+            text = os.read(handle, 4096)
+        finally:
+            os.close(handle)
+    except OSError:
+        return 0, 0.0
+    fields = text[text.rfind(b")") + 2 :].split()  # after the name, which may hold spaces
+    # fields[0] is field 3 (state): utime, stime, cutime, cstime are fields 14-17, num_threads 20
+    return int(fields[17]), sum(int(v) for v in fields[11:15]) / _CLOCK_TICKS

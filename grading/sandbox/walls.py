@@ -1,0 +1,355 @@
+"""The walls around a worker: the isolation levels, what each one needs, and what a sandbox uid leaves.
+
+``bubblewrap``
+    ``bwrap --unshare-all`` (user, pid, network, ipc, uts and cgroup
+    namespaces), ``--die-with-parent``, ``--new-session``, a cleared
+    environment and a filesystem built from nothing
+    (:mod:`grading.sandbox.bubblewrap`).
+``uid``
+    No namespaces (a container that forbids them), but the grader is root:
+    the worker runs as a dedicated unprivileged uid (one per ``batch`` slot,
+    reserved by :func:`reserve_uid`) and the grader bars every sandbox uid
+    from the forbidden packages with a POSIX ACL (:func:`bar_sandbox_uids`),
+    then checks, as that uid, that the course's tests, solutions and
+    ``.git`` and those packages cannot be read (:func:`permission_wall`),
+    and that a seccomp filter closes the network (:func:`network_wall`; the
+    worker refuses to run without it). Everything that uid left running is
+    killed after each worker, and every file it owns in the world-writable
+    folders is removed before and after each submission
+    (:func:`remove_files_of`).
+``none``
+    Neither: the worker runs as the grader's own user, with the resource
+    limits only. Grading still runs, but the result is a local check, not a
+    mark, and says so; ``--require-isolation`` refuses this level.
+"""
+
+import json
+import os
+import shutil
+import stat
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass
+from functools import cache
+from pathlib import Path
+
+from grading import REPO_ROOT, config
+from grading.errors import SandboxError
+from grading.sandbox.bubblewrap import (
+    PROTOCOL,
+    WORKER,
+    bubblewrap_command,
+    masked_paths,
+    python_executable,
+    site_packages,
+    spawn,
+)
+from grading.sandbox.processes import become_subreaper, kill_uid, preexec
+
+PROTECTED = ("tests", "solutions", ".git")  # of the course copy: never readable by a submission
+
+BUBBLEWRAP, UID, NONE = "bubblewrap", "uid", "none"
+
+
+@dataclass(frozen=True)
+class Isolation:
+    """How a worker is isolated: ``level`` (bubblewrap, uid or none), the
+    uid that runs it (None: the grader's own) and, below bubblewrap, why."""
+
+    level: str
+    uid: int = None
+    reason: str = ""
+
+    @property
+    def isolated(self):
+        return self.level != NONE
+
+    def describe(self):
+        if self.level == BUBBLEWRAP:
+            who = f"uid {self.uid}" if self.uid is not None else "the grader's user"
+            return f"isolated: bubblewrap sandbox (no network, no files of the grader's), as {who}"
+        if self.level == UID:
+            return (
+                f"isolated: dedicated uid {self.uid} that cannot read the grader's files, network closed by "
+                f"a seccomp filter; no namespaces ({self.reason})"
+            )
+        return f"NOT ISOLATED ({self.reason}): this is a local check, not a mark"
+
+
+def make_reachable(path):
+    """Let the sandbox user reach ``path``: search permission (o+x) on its ancestors.
+
+    Search permission alone lets it pass through a directory without listing
+    it: a virtual environment under a private directory (``mktemp -d`` is
+    mode 0700, ``/root`` too) would otherwise be out of the sandbox user's
+    reach, and bubblewrap, which runs as that user, could not bind it.
+    """
+    for parent in [*Path(path).resolve().parents]:
+        mode = parent.stat().st_mode
+        if not mode & stat.S_IXOTH:
+            os.chmod(parent, stat.S_IMODE(mode) | stat.S_IXOTH)
+
+
+def bar_sandbox_uids(paths):
+    """Deny every sandbox uid all access to ``paths`` with a POSIX ACL (``setfacl``).
+
+    Without namespaces nothing can hide a file from a process, but a named
+    ACL entry with no permission bars that one uid and changes nothing for
+    anyone else (the grader, the book's build, other users of the
+    environment). A folder barred is barred whole: nothing below it can be
+    reached. Returns None when done, else why not.
+    """
+    if not paths:
+        return None
+    if not shutil.which("setfacl"):
+        return "setfacl is not installed, to bar the sandbox uids from the forbidden packages (apt-get install acl)"
+    uids = range(config.SANDBOX_UID_BASE, config.SANDBOX_UID_BASE + config.SANDBOX_UID_SLOTS)
+    entries = ",".join(f"u:{uid}:---" for uid in uids)
+    completed = subprocess.run(
+        ["setfacl", "-P", "-m", entries, "--", *[str(p) for p in paths]], capture_output=True, text=True
+    )
+    if completed.returncode != 0:
+        why = (completed.stderr.strip().splitlines() or ["?"])[-1]
+        return f"the sandbox uids could not be barred from the forbidden packages ({why})"
+    return None
+
+
+WRITABLE_ROOTS = ("/tmp", "/var/tmp", "/dev/shm", "/run/lock", "/var/lock", "/dev/mqueue")
+
+
+def remove_files_of(uid, roots=WRITABLE_ROOTS):
+    """Remove every file and folder that ``uid`` owns below ``roots``.
+
+    A dedicated uid can create entries only where others may write: in
+    world-writable folders (recursed into) and in its own folders (removed
+    whole). Called before and after each submission in the uid mode, whose
+    processes are all dead by then, so that nothing one submission wrote is
+    there for the next one to find. Links are removed, never followed.
+    """
+    stack = [(root, 0) for root in roots]
+    while stack:
+        folder, depth = stack.pop()
+        try:
+            entries = list(os.scandir(folder))
+        except OSError:
+            continue
+        for entry in entries:
+            try:
+                info = entry.stat(follow_symlinks=False)
+            except OSError:
+                continue
+            is_folder = stat.S_ISDIR(info.st_mode)
+            if info.st_uid == uid:
+                if is_folder:
+                    shutil.rmtree(entry.path, ignore_errors=True)
+                else:
+                    try:
+                        os.unlink(entry.path)
+                    except OSError:
+                        pass
+            elif is_folder and info.st_mode & stat.S_IWOTH and depth < 32:
+                stack.append((entry.path, depth + 1))
+
+
+def _probe_script(paths):
+    return (
+        "import os, sys\n"
+        f"sys.path.append({str(site_packages())!r})\n"
+        "import numpy\n"
+        "readable = []\n"
+        f"for path in {[str(p) for p in paths]!r}:\n"
+        "    try:\n"
+        "        os.listdir(path) if os.path.isdir(path) else open(path).close()\n"
+        "        readable.append(path)\n"
+        "    except OSError:\n"
+        "        pass\n"
+        "import json\n"
+        "print(json.dumps(readable))\n"
+    )
+
+
+_HELD_UIDS = {}  # uid -> the open lock file that reserves it for this process
+
+
+def reserve_uid(preferred=None):
+    """A sandbox uid that no other grading process on this machine uses now.
+
+    The uids of :data:`grading.config.SANDBOX_UID_BASE` onwards are reserved
+    with an exclusive ``flock`` on a lock file in a root-only folder, held
+    until this process exits: two graders (two ``batch`` slots, two test
+    workers, two instructors) never share a uid, so that killing what one
+    left running never touches the other.
+    """
+    import fcntl
+
+    if _HELD_UIDS:
+        return next(iter(_HELD_UIDS))
+    folder = Path(tempfile.gettempdir()) / "pcl-grading-uids"
+    folder.mkdir(mode=0o700, exist_ok=True)
+    if folder.stat().st_uid != os.geteuid() or stat.S_IMODE(folder.stat().st_mode) & 0o077:
+        raise SandboxError(f"{folder} must belong to the grader's user with mode 0700")
+    base, slots = config.SANDBOX_UID_BASE, config.SANDBOX_UID_SLOTS
+    order = list(range(base, base + slots))
+    if preferred is not None and preferred in order:
+        order.remove(preferred)
+        order.insert(0, preferred)
+    for uid in order:
+        handle = open(folder / f"{uid}.lock", "w")
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            handle.close()
+            continue
+        _HELD_UIDS[uid] = handle
+        return uid
+    raise SandboxError(f"all {slots} sandbox uids from {base} are in use by other graders")
+
+
+def _bubblewrap_works(uid):
+    """None if a bubblewrap worker starts here for ``uid``, else why not."""
+    if not shutil.which("bwrap"):
+        return "bubblewrap (bwrap) is not installed"
+    staged = Path(tempfile.mkdtemp(prefix="grading-probe-"))
+    try:
+        os.chmod(staged, 0o711)
+        (staged / "pcl_course").mkdir(mode=0o755)
+        for name, text in ((WORKER.name, "import sys\n"), (PROTOCOL.name, "")):  # the worker itself imports numpy
+            (staged / name).write_text(text)
+            (staged / name).chmod(0o644)
+        probe = spawn(
+            bubblewrap_command(staged, []),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            preexec_fn=preexec(uid),
+            env={},
+        )
+        _, stderr = probe.communicate(timeout=60)
+        if probe.returncode == 0:
+            return None
+        return "bubblewrap cannot run here: " + (stderr.strip().splitlines() or ["?"])[-1]
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"bubblewrap cannot run here: {exc}"
+    finally:
+        shutil.rmtree(staged, ignore_errors=True)
+        if uid is not None:
+            kill_uid(uid)
+
+
+def permission_wall(uid, protected):
+    """None if ``uid`` can run Python here but read none of ``protected``, else why not.
+
+    Run as ``uid`` itself: what it can read is measured, not inferred from
+    mode bits.
+    """
+    try:
+        completed = subprocess.run(
+            [str(python_executable()[0]), "-I", "-S", "-c", _probe_script(protected)],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            preexec_fn=preexec(uid),
+            env={},
+            cwd="/",
+        )
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"uid {uid} cannot run Python: {exc}"
+    finally:
+        kill_uid(uid)
+    if completed.returncode != 0:
+        return f"uid {uid} cannot use the Python environment at {sys.prefix}"
+    lines = [line for line in completed.stdout.splitlines() if line.startswith("[")]
+    readable = json.loads(lines[-1]) if lines else ["?"]
+    if readable:
+        if readable[0] in {str(p) for p in masked_paths()}:
+            return f"uid {uid} can still read the forbidden package {readable[0]}"
+        return (
+            f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
+            f"(chmod 700) and keep the Python environment outside it"
+        )
+    return None
+
+
+def network_wall(uid):
+    """None if a worker running as ``uid`` can close its network (seccomp), else why not.
+
+    Run as ``uid`` with the worker's own code (``--check-network``): the
+    socket it then fails to open is measured, not assumed.
+    """
+    folder = tempfile.mkdtemp(prefix="grading-network-")  # the course's copy is out of the uid's reach
+    os.chmod(folder, 0o755)
+    os.chmod(shutil.copy(WORKER, folder), 0o644)
+    try:
+        completed = subprocess.run(
+            [
+                str(python_executable()[0]),
+                "-I",
+                "-S",
+                f"{folder}/{WORKER.name}",
+                "--check-network",
+                str(site_packages()),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=60,
+            preexec_fn=preexec(uid),
+            env={"PATH": "/usr/bin:/bin"},
+            cwd="/",
+        )
+        answer = json.loads(completed.stdout.strip().splitlines()[-1])
+    except (OSError, subprocess.SubprocessError) as exc:
+        return f"the network could not be closed: the check failed ({exc})"
+    except (ValueError, IndexError):
+        why = (completed.stderr.strip().splitlines() or ["no output"])[-1]
+        return f"the network could not be closed: the check failed ({why})"
+    finally:
+        kill_uid(uid)
+        shutil.rmtree(folder, ignore_errors=True)
+    return None if answer.get("closed") else f"the network could not be closed: {answer.get('why')}"
+
+
+@cache
+def isolation(uid=None):
+    """The strongest isolation available here for the sandbox ``uid``.
+
+    Parameters
+    ----------
+    uid : int, optional
+        The preferred dedicated uid when the grader is root (the one
+        reserved is :func:`reserve_uid`'s); ignored otherwise.
+
+    Returns
+    -------
+    Isolation
+        ``bubblewrap`` if a worker starts in it (unless
+        :data:`grading.config.SANDBOX_NAMESPACES` is off); else ``uid`` if
+        the grader is root and the dedicated uid can read none of the
+        course's :data:`PROTECTED` folders; else ``none``, with the reasons.
+    """
+    root = os.geteuid() == 0
+    uid = reserve_uid(uid) if root else None
+    become_subreaper()  # the probe's orphans come back here to be reaped
+    if root:
+        make_reachable(Path(sys.base_prefix) / "lib")
+        make_reachable(site_packages())
+    if config.SANDBOX_NAMESPACES:
+        why_not = _bubblewrap_works(uid)
+        if why_not is None:
+            return Isolation(BUBBLEWRAP, uid)
+    else:
+        why_not = "namespaces switched off (PCL_SANDBOX_NAMESPACES=0)"
+    if not root:
+        return Isolation(NONE, None, f"{why_not}; the grader is not root, so no dedicated uid")
+    # The second wall: a dedicated uid that can read neither the grader's files nor the forbidden packages.
+    barred = bar_sandbox_uids(masked_paths())
+    if barred is not None:
+        return Isolation(NONE, None, f"{why_not}; {barred}")
+    protected = [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()]
+    wall = permission_wall(uid, [*protected, *masked_paths()])
+    if wall is not None:
+        return Isolation(NONE, None, f"{why_not}; {wall}")
+    network = network_wall(uid)
+    if network is not None:
+        return Isolation(NONE, None, f"{why_not}; {network}")
+    return Isolation(UID, uid, why_not)
