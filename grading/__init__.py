@@ -1,26 +1,39 @@
-"""The course autograder.
+"""The course autograder, in three rooms.
 
-* :mod:`grading.cli` -- ``python -m grading grade | batch | release | gradescope | autograde | similarity``.
+**The engine** (ships to students; ``python -m grading grade``):
+
+* :mod:`grading.cli` -- the command line; the instructors' commands come from
+  :mod:`grading.instructors.commands` where that folder exists.
+* :mod:`grading.options` -- the options of a grading run and the graded
+  tests' markers, declared once.
 * :mod:`grading.runner` -- the pytest process that runs the graded tests.
-* :mod:`grading.results` -- the results as data (:class:`~grading.results.Grading`),
-  written to Gradescope's JSON and the terminal table, every submission text sanitised.
 * :mod:`grading.plugin` -- pytest plugin: the ``impl`` fixture that hands the
   implementation under test to graded tests, points per test, per-test
-  timeouts, short feedback and the results file.
+  timeouts, the diagnosis and the results file.
+* :mod:`grading.feedback` -- what a failed test says: its kind, its rule and
+  the student-visible line, classified once.
+* :mod:`grading.diagnosis` -- names a mistake from a function's calls and verdicts.
+* :mod:`grading.results` -- the results as data (:class:`~grading.results.Grading`),
+  written to Gradescope's JSON and the terminal table, every submission text sanitised.
 * :mod:`grading.implementation` -- the implementation under test: the
   reference or a project mutant in-process (trusted code), a student's
   submission staged and run in the sandbox.
 * :mod:`grading.staging` -- copies a submission's ``pcl_course/`` without
   following links: regular files only, with caps.
-* :mod:`grading.sandbox` -- the isolated worker
-  process (bubblewrap, or a dedicated uid) and its plain-data protocol.
 * :mod:`grading.forbidden` -- the static scan for forbidden APIs.
-* :mod:`grading.checks` -- assertions with student-readable messages.
-* :mod:`grading.config` -- every limit and constant of the grader.
+* :mod:`grading.checks` -- assertions with student-readable messages; one
+  module per exercise module that needs its own (``checks/nn.py``: trees).
+* :mod:`grading.config` -- what is graded, every limit and constant.
 * :mod:`grading.errors` -- the grader's own exceptions.
-* :mod:`grading.release` and :mod:`grading.leakcheck` -- the student repository.
-* :mod:`grading.gradescope` -- the Gradescope archive, and `autograde` inside it.
-* :mod:`grading.similarity` -- the similarity report of a class (copydetect).
+
+**The sandbox** (ships too): :mod:`grading.sandbox`, the isolated worker
+process, one job per module.
+
+**The instructors' tools** (never in a student's copy):
+:mod:`grading.instructors` -- release, Gradescope, the class ``batch`` and
+its gradebook, the similarity report, the leak check, the catalogue of known
+mistakes and each lecture's own checkers (``trees.py``). A copy of the
+grader without that folder is a student's (:func:`instructors_grader`).
 """
 
 from pathlib import Path
@@ -28,6 +41,17 @@ from pathlib import Path
 REPO_ROOT = Path(__file__).resolve().parent.parent
 GRADED_TESTS = REPO_ROOT / "tests" / "graded"  # public: shipped to students
 HIDDEN_TESTS = REPO_ROOT / "tests" / "hidden"  # run only by the instructors' grader
+INSTRUCTORS = Path(__file__).resolve().parent / "instructors"  # the one folder a release withholds
+
+
+def instructors_grader():
+    """Whether this is the instructors' grader (the course repository, the Gradescope archive).
+
+    The one test of a student's copy: the release withholds
+    ``grading/instructors/`` whole, and nothing else of the grader's.
+    """
+    return INSTRUCTORS.is_dir()
+
 
 from grading.config import (  # noqa: E402,F401
     ASSIGNMENT_MODULES,

@@ -12,7 +12,7 @@ this order, and stops at the first finding:
    that is not the contract's (a wrong argument order);
 3. an input modified in place; answers of the wrong type or dtype;
 4. a known mistake of that function (the catalogue in
-   :mod:`grading.mistakes`, which ships with the instructors' grader only):
+   :mod:`grading.instructors.mistakes`, which ships with the instructors' grader only):
    each mistake predicts, grader-side, what it would answer on the same
    inputs, and is named when the student's answers equal its predictions on
    the calls where it differs from the right answer, in more failed tests
@@ -527,7 +527,7 @@ def diagnose(function, calls, outcomes, model=None, sources=None):
     outcomes : dict
         Test id -> :class:`Outcome`, for the function's tests.
     model : object, optional
-        The function's catalogue entry (:mod:`grading.mistakes`): ``truth``,
+        The function's catalogue entry (:mod:`grading.instructors.mistakes`): ``truth``,
         ``same``, ``mistakes`` and ``output_dtypes``.
     sources : dict, optional
         Exercise module name -> the submission's source text (for the

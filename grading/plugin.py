@@ -4,25 +4,15 @@ A graded test is a test that takes the ``impl`` fixture: the implementation
 under test, whose graded functions are its attributes (``impl.pca(...)``).
 Graded tests never import ``pcl_course`` or ``solutions`` exercises directly.
 
-Options
--------
---impl DIR
-    Folder of exercise modules to grade (default: ``pcl_course/`` under the
-    rootdir, i.e. the student's own code).
---impl-module MODULE=FILE
-    Replace one module of ``--impl`` by a file (repeatable).
---results FILE
-    Write the Gradescope results JSON there.
-
-Markers
--------
-``@pytest.mark.grades(name)``: the graded function the test grades (required).
-``@pytest.mark.hidden``: run by the instructors' grader only; feedback withheld.
-``@pytest.mark.interface``: tests shapes, dtypes, errors or in-place changes only.
-``@pytest.mark.points(n)``: what the test is worth (default 1).
-``@pytest.mark.timeout(s)``: its time limit (default :data:`grading.config.TEST_TIMEOUT`).
+Its options (``--impl DIR``, ``--impl-module MODULE=FILE``, ``--results
+FILE``, ``--function NAME``, ...) and the graded tests' markers
+(``grades(name)``, required; ``hidden``, ``interface``, ``points(n)``) are
+declared in :mod:`grading.options`; ``@pytest.mark.timeout(s)`` sets a
+test's time limit (default :data:`grading.config.TEST_TIMEOUT`). What a
+failed test says comes from :mod:`grading.feedback`.
 """
 
+import importlib
 import json
 import os
 import signal
@@ -32,25 +22,17 @@ from pathlib import Path
 
 import pytest
 
-from grading import GRADED_FUNCTIONS, diagnosis
+from grading import GRADED_FUNCTIONS, diagnosis, instructors_grader
 from grading import config as grading_config
 from grading.diagnosis import Outcome
-from grading.errors import (
-    CheckFailed,
-    DidNotRaise,
-    ForbiddenAPI,
-    NotImplementedYet,
-    SandboxError,
-    StagingError,
-    TestTimeout,
-)
+from grading.errors import SandboxError, TestTimeout
+from grading.feedback import classify
 from grading.implementation import Implementation
-from grading.results import HIDDEN_NOTE, Grading, TestResult, clean
+from grading.options import MARKERS, PLUGIN_ONLY, SHARED
+from grading.results import Grading, TestResult, clean
 
-try:
-    from grading import mistakes
-except ImportError:  # the student release has no catalogue of mistakes
-    mistakes = None
+# The catalogue of known mistakes: the instructors' grader only (a student's copy has none).
+mistakes = importlib.import_module("grading.instructors.mistakes") if instructors_grader() else None
 
 _IMPL_KEY = pytest.StashKey[Implementation]()
 _RESULTS_KEY = pytest.StashKey[dict]()
@@ -62,83 +44,13 @@ _ALARM_KEY = pytest.StashKey[object]()  # a graded test's previous SIGALRM handl
 
 def pytest_addoption(parser):
     group = parser.getgroup("grading", "course autograder")
-    group.addoption(
-        "--impl", default=None, metavar="DIR", help="folder of exercise modules to grade (default: ./pcl_course)"
-    )
-    group.addoption(
-        "--impl-module",
-        action="append",
-        default=[],
-        metavar="MODULE=FILE",
-        help="replace one exercise module of --impl by FILE",
-    )
-    group.addoption("--results", default=None, metavar="FILE", help="write the results (Gradescope JSON) to FILE")
-    group.addoption(
-        "--sandbox", action="store_true", help="run the implementation in a limited worker process (grading/sandbox/)"
-    )
-    group.addoption(
-        "--call-timeout",
-        type=float,
-        default=grading_config.CALL_TIMEOUT,
-        metavar="SECONDS",
-        help=f"CPU seconds of one call in the sandbox (default {grading_config.CALL_TIMEOUT:g}; "
-        f"{grading_config.CALL_WALL_FACTOR:g} times as many seconds of wall clock stop a call that waits)",
-    )
-    group.addoption(
-        "--sandbox-uid",
-        type=int,
-        default=None,
-        metavar="UID",
-        help="the dedicated uid that runs the submission when the grader is root",
-    )
-    group.addoption(
-        "--budget",
-        type=float,
-        default=grading_config.SUBMISSION_BUDGET,
-        metavar="SECONDS",
-        help=f"wall-clock budget of the whole grading (default {grading_config.SUBMISSION_BUDGET:g}); "
-        "tests not started by then score 0",
-    )
-    group.addoption(
-        "--function",
-        action="append",
-        default=[],
-        metavar="NAME",
-        help="run only the graded tests of this function (their grades marker); repeatable",
-    )
-    group.addoption(
-        "--diagnose-always",
-        action="store_true",
-        help="run the diagnosis on full-marks functions too (the project's check for false diagnoses)",
-    )
-    group.addoption(
-        "--submission-note",
-        default=None,
-        metavar="TEXT",
-        help="a first line of the results' output (e.g. which files of an upload were graded)",
-    )
-    group.addoption(
-        "--grading-options",
-        default=None,
-        metavar="FILE",
-        help="a JSON file of options (impl, results, submission_note) that name a submission's paths: "
-        "kept off the command line, which any process can read in /proc",
-    )
-    group.addoption(
-        "--require-isolation",
-        action="store_true",
-        help="refuse to grade unless the submission runs isolated (bubblewrap or a dedicated uid)",
-    )
+    for option in (*SHARED, *PLUGIN_ONLY):  # declared once, in grading/options.py
+        option.add_to(group, public=False)
 
 
 def pytest_configure(config):
-    config.addinivalue_line("markers", "points(n): marks that a graded test is worth")
-    config.addinivalue_line("markers", "grades(function): the graded function a test grades")
-    config.addinivalue_line("markers", "hidden: a graded test run by the instructors' grader only")
-    config.addinivalue_line(
-        "markers",
-        "interface: a graded test of shapes, dtypes, errors or in-place changes only (a degenerate answer may pass it)",
-    )
+    for line in MARKERS.values():  # declared once, in grading/options.py
+        config.addinivalue_line("markers", line)
     config.stash[_RESULTS_KEY] = {}
 
 
@@ -235,107 +147,6 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if _is_graded(item) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(grading_config.TEST_TIMEOUT))
-
-
-def _location_in_implementation(excinfo, impl):
-    roots = [impl.directory, *impl.overrides.values()]
-    for entry in reversed(excinfo.traceback):
-        path = Path(str(entry.path))
-        if any(path == root or root in path.parents for root in roots):
-            return f"{path.name}:{entry.lineno + 1} in {entry.name}"
-    return None
-
-
-# What a hidden test says of a sandbox failure: fixed words per kind, no text of the submission's.
-_HIDDEN_SANDBOX = {
-    SandboxError.TIMEOUT: "timed out",
-    SandboxError.DIED: "the submission's process died",
-    SandboxError.GARBLED: "the answer could not be read",
-    SandboxError.TOO_LARGE: "the answer was too large",
-    SandboxError.UNSUPPORTED: "the answer was not plain numbers and arrays",
-    SandboxError.IMPORT: "the module could not be imported",
-    SandboxError.STRAY: "processes or threads were left running",
-    SandboxError.GENERATOR: "the random generator was set, not drawn from",
-    SandboxError.RAISED: "raised an exception",
-}
-
-
-def _hidden_feedback(excinfo):
-    """A hidden test's feedback: which rule broke, in the grader's words only.
-
-    Never a value of its inputs or answers, and no text the submission
-    produced (an exception's message, type or place, a file name, its
-    output): a hidden test's inputs are fixed, so any such text could carry
-    them out. The public tests say the rest.
-    """
-    exc = excinfo.value
-    if isinstance(exc, DidNotRaise):
-        text = "expected the call to raise an error, but it returned normally"
-    elif isinstance(exc, CheckFailed):
-        text = exc.public_rule or "a check of the answer failed"
-    elif isinstance(exc, NotImplementedYet):
-        text = "not implemented"
-    elif isinstance(exc, ForbiddenAPI):
-        text = "the module uses a forbidden API (the public tests say which)"
-    elif isinstance(exc, StagingError):
-        text = "the submission was refused (the public tests say why)"
-    elif isinstance(exc, SandboxError):
-        text = _HIDDEN_SANDBOX.get(exc.kind, "the call failed")
-    elif isinstance(exc, TestTimeout):
-        text = "timed out"
-    elif isinstance(exc, AssertionError):
-        text = "a check of the answer failed"
-    else:
-        text = "raised an exception"
-    return f"{text} {HIDDEN_NOTE}"
-
-
-def _feedback(excinfo, impl):
-    """One short, readable explanation of a failure."""
-    exc = excinfo.value
-    last_call = f"\n  last call: {impl.last_call}" if impl and impl.last_call else ""
-    if isinstance(exc, (NotImplementedYet, ForbiddenAPI, StagingError)):
-        return str(exc)
-    text = str(exc).strip()
-    if isinstance(exc, SandboxError):
-        return f"{text}{last_call}"
-    if isinstance(exc, TestTimeout):
-        return f"{text}{last_call}"
-    if isinstance(exc, AssertionError):
-        lines = text.splitlines()
-        # pytest appends its introspection ("assert ...", "+ where ...") to a
-        # message: the test's own message is the clearer part.
-        cut = next((i for i, line in enumerate(lines) if line.startswith("assert ")), None)
-        if cut:
-            lines = lines[:cut]
-        lines = lines[: grading_config.MAX_FEEDBACK_LINES] or ["assertion failed"]
-        return "\n".join(lines) + last_call
-    where = getattr(exc, "where", None) or (_location_in_implementation(excinfo, impl) if impl else None)
-    where = f"\n  at {where}" if where else ""
-    first = text.splitlines()[0] if text else ""
-    return f"raised {excinfo.typename}: {first}{where}{last_call}"
-
-
-def _outcome(excinfo):
-    """How a test failed, for the diagnosis (:class:`grading.diagnosis.Outcome`): by the exception's class."""
-    if excinfo is None:
-        return Outcome(False, diagnosis.ERROR)
-    exc = excinfo.value
-    for kind, classes in (
-        (diagnosis.NOT_IMPLEMENTED, NotImplementedYet),
-        (diagnosis.FORBIDDEN, ForbiddenAPI),
-        (diagnosis.REFUSED, StagingError),
-        (diagnosis.SANDBOX, SandboxError),
-        (diagnosis.DID_NOT_RAISE, DidNotRaise),
-        (diagnosis.TIMEOUT, TestTimeout),
-    ):
-        if isinstance(exc, classes):
-            return Outcome(False, kind)
-    if isinstance(exc, CheckFailed):
-        return Outcome(False, diagnosis.CHECK, exc.rule)
-    if isinstance(exc, AssertionError):
-        return Outcome(False, diagnosis.ASSERTION)
-    return Outcome(False, diagnosis.ERROR)
 
 
 def _run_diagnosis(config, function, tests, always):
@@ -482,23 +293,13 @@ def pytest_runtest_makereport(item, call):
         result.score, result.passed, result.feedback = result.max_score, True, ""
         outcomes[item.nodeid] = Outcome(True)
     elif report.failed:
-        impl = item.config.stash.get(_IMPL_KEY, None)
-        if not call.excinfo:
-            message = "failed"
-        elif result.hidden:
-            message = _hidden_feedback(call.excinfo)
-        else:
-            message = _feedback(call.excinfo, impl)
-        if report.when != "call":
-            message = f"error in test {report.when}: {message}"
+        failure = classify(call.excinfo, item.config.stash.get(_IMPL_KEY, None), hidden=result.hidden)
+        message = failure.line if report.when == "call" else f"error in test {report.when}: {failure.line}"
         result.score, result.passed = 0.0, False
         result.set_feedback(message)
-        outcomes[item.nodeid] = _outcome(call.excinfo)
+        outcomes[item.nodeid] = Outcome(False, failure.kind, failure.rule)
         outcomes[item.nodeid].interface = item.get_closest_marker("interface") is not None
-        if isinstance(
-            call.excinfo.value if call.excinfo else None,
-            (NotImplementedYet, ForbiddenAPI, StagingError, SandboxError, TestTimeout),
-        ):
+        if failure.one_line:
             report.longrepr = result.feedback  # one line, not a traceback
     elif report.skipped and report.when != "teardown":
         reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else "skipped"

@@ -1,7 +1,8 @@
 """Run the graded tests in their own pytest process (``python -m pytest`` with the grader's plugin).
 
-Used by ``python -m grading grade`` and ``batch`` (:mod:`grading.cli`) and by
-Gradescope's ``autograde`` (:mod:`grading.gradescope`).
+Used by ``python -m grading grade`` (:mod:`grading.cli`), ``batch``
+(:mod:`grading.instructors.batch`) and Gradescope's ``autograde``
+(:mod:`grading.instructors.gradescope`).
 """
 
 import json
@@ -12,29 +13,17 @@ import sys
 import tempfile
 
 from grading import GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT
+from grading.options import pytest_arguments
 
 PYTEST_EXIT_NO_TESTS = 5
 PYTEST_EXIT_USAGE = 4
 
 
-def run_graded_tests(
-    impl_dir,
-    results,
-    keyword=None,
-    junit=None,
-    overrides=(),
-    tests=None,
-    sandbox=False,
-    call_timeout=None,
-    require_isolation=False,
-    sandbox_uid=None,
-    functions=(),
-    budget=None,
-    note=None,
-    diagnose_always=False,
-):
+def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None, note=None, **options):
     """Run the graded tests on ``impl_dir`` in a pytest process; return its exit code and its output.
 
+    ``options`` are the grading process's own (:mod:`grading.options`, by
+    their dest: ``budget``, ``function``, ``sandbox``, ``sandbox_uid``, ...).
     The paths that name a submission (its folder, its results file) and the
     note on it go to pytest in a file only the grader's user can read, not
     on its command line: any process, a submission graded beside this one
@@ -62,25 +51,10 @@ def run_graded_tests(
         "--tb=no",
         "--no-header",
         "-rN",
+        *pytest_arguments(options),
     ]
-    for override in overrides:
-        command += ["--impl-module", override]
-    if sandbox:
-        command.append("--sandbox")
-    if require_isolation:
-        command.append("--require-isolation")
-    if sandbox_uid is not None:
-        command += ["--sandbox-uid", str(sandbox_uid)]
-    if call_timeout:
-        command += ["--call-timeout", str(call_timeout)]
     if keyword:
         command += ["-k", keyword]
-    for function in functions:
-        command += ["--function", function]
-    if budget is not None:
-        command += ["--budget", str(budget)]
-    if diagnose_always:
-        command.append("--diagnose-always")
     if junit:
         command += ["--junitxml", str(junit)]
     # Only the plugins named above: the environment's others (nbval, dash,

@@ -2,9 +2,9 @@
 
 Expected neighbours come from brute force (every distance, sorted by
 (squared distance, index) with ``np.lexsort``); builds are checked rule by
-rule (``grading/treechecks.py``), each failure naming the rule, and against
+rule (``grading/checks/nn.py``), each failure naming the rule, and against
 hand-built examples. The searches run on trees the grader builds
-(``grading/trees.py``, in the instructors' grader): a wrong build costs its
+(``grading/instructors/trees.py``, in the instructors' grader): a wrong build costs its
 own points once. In the student release that module is absent, so these
 tests search your own build, after checking it.
 
@@ -15,12 +15,13 @@ are hidden: ``tests/hidden/test_nn_hidden.py``.
 import numpy as np
 import pytest
 
+from grading import instructors_grader
 from grading.checks import check_array, raises
-from grading.treechecks import check_bst, check_csr, check_kdtree, check_knn, check_octree
+from grading.checks.nn import check_bst, check_csr, check_kdtree, check_knn, check_octree
 
-try:  # the instructors' grader (Gradescope, batch): its own trees
-    from grading import trees as grader_trees
-except ImportError:  # the student release: your own build, checked first
+if instructors_grader():  # the instructors' grader (Gradescope, batch): its own trees
+    from grading.instructors import trees as grader_trees
+else:  # the student release: your own build, checked first
     grader_trees = None
 
 

@@ -1,7 +1,7 @@
 """Hidden graded tests of lecture 2 (``pcl_course/nn.py``): the searches' structure, on lying trees.
 
 Each structure test hands the submission a tree built by the grader
-(``grading/trees.py``) whose unreached nodes lie: one point of every node
+(``grading/instructors/trees.py``) whose unreached nodes lie: one point of every node
 the contract's rule does not reach is moved next to the query. A search
 that follows the rule, or prunes more, never reads them and returns the
 brute-force answer of the original cloud; a search that reads more
@@ -19,9 +19,9 @@ of blaming the structure.
 import numpy as np
 import pytest
 
-from grading import trees
+from grading.checks.nn import check_csr, check_kdtree, check_knn, check_octree
 from grading.errors import CheckFailed
-from grading.treechecks import check_csr, check_kdtree, check_knn, check_octree
+from grading.instructors import trees
 
 pytestmark = pytest.mark.hidden
 

@@ -1,7 +1,7 @@
 """Plain-Python trees and searches for the lecture-2 mutants, each mistake a flag.
 
 Written the way a student writes them (recursion, sorted lists), apart from
-the grader's own trees (``grading/trees.py``): a mutant and its diagnosis are
+the grader's own trees (``grading/instructors/trees.py``): a mutant and its diagnosis are
 two independent codings of one mistake, so the diagnosis check can fail. The
 mutants in the folders next to this file call these with one flag changed;
 their docstrings say what they get wrong. Trusted code: only the project's

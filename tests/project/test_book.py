@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from grading import REPO_ROOT
-from grading.leakcheck import code_lines
+from grading.instructors.leakcheck import code_lines
 
 HTML = REPO_ROOT / "_build" / "html"
 

@@ -26,7 +26,7 @@ import pytest
 from _helpers import SUBPROCESS_BACKSTOP, load_results, reference_package, reference_source
 
 from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, REPO_ROOT
-from grading.leakcheck import find_leaks
+from grading.instructors.leakcheck import find_leaks
 from grading.sandbox import make_reachable
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="the dedicated-uid wall needs a root grader")

@@ -2,6 +2,7 @@
 and lost points for every wrong submission in tests/mutants."""
 
 import ast
+import importlib
 import subprocess
 import sys
 
@@ -9,8 +10,9 @@ import pytest
 from _helpers import load_results
 from _helpers import run_grader as grade
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT, mistakes
+from grading import GRADED_FUNCTIONS, REPO_ROOT
 from grading.diagnosis import ONE_LINE_ALREADY
+from grading.instructors import mistakes
 
 
 def test_reference_gets_full_marks(reference_grading):
@@ -256,6 +258,24 @@ def grade_together(files, tmp_path, *extra):
         tmp_path=tmp_path,
     )
     return summary
+
+
+@pytest.mark.parametrize("function", list(GRADED_FUNCTIONS))
+def test_every_graded_function_has_a_catalogue_entry_or_an_explicit_none(function):
+    """The catalogue module named after the function's exercise module lists it: a Model, or None said."""
+    module = GRADED_FUNCTIONS[function]
+    try:
+        catalogue = importlib.import_module(f"grading.instructors.mistakes.{module}")
+    except ModuleNotFoundError:
+        pytest.fail(f"no grading/instructors/mistakes/{module}.py: each exercise module has its catalogue")
+    assert function in catalogue.MODELS, (
+        f"grading/instructors/mistakes/{module}.py: MODELS has no entry for {function} (a Model, or None)"
+    )
+    entry = catalogue.MODELS[function]
+    assert entry is None or isinstance(entry, mistakes.Model), f"{function}: {type(entry).__name__}, not a Model"
+    assert mistakes.model(function) is entry
+    strays = [name for name in catalogue.MODELS if GRADED_FUNCTIONS.get(name) != module]
+    assert not strays, f"grading/instructors/mistakes/{module}.py lists {strays}: not graded functions of {module}.py"
 
 
 def check_wrong_submission(mutant, summary):

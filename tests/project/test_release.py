@@ -12,8 +12,8 @@ import yaml
 from _helpers import STEP_BACKSTOP, SUBPROCESS_BACKSTOP, load_results
 
 from grading import EXERCISE_MODULES, REPO_ROOT
-from grading.leakcheck import find_leaks
-from grading.shipping import INSTRUCTOR_ONLY_GRADER
+from grading.instructors.leakcheck import find_leaks
+from grading.instructors.shipping import WITHHELD
 
 
 @pytest.fixture(scope="module")
@@ -51,7 +51,7 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
         assert (release_dir / needed).exists(), needed
     for absent in (
         "solutions",
-        "grading/mistakes",
+        "grading/instructors/mistakes",
         "tests/mutants",
         "tests/alternatives",
         "tests/project",
@@ -60,7 +60,7 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
         ".ci",
         "requirements/course.txt",
         "requirements/course.in",
-        *INSTRUCTOR_ONLY_GRADER,
+        WITHHELD,
     ):
         assert not (release_dir / absent).exists(), absent
     for module in EXERCISE_MODULES:
@@ -71,7 +71,7 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
 
 
 def test_instructor_solutions_are_removed_and_self_check_answers_kept(release_dir):
-    from grading.release import _strip_solutions
+    from grading.instructors.release import _strip_solutions
 
     page = (
         "Intro.\n\n:::{exercise}\n:label: a\nQuestion A.\n:::\n\n"
@@ -139,7 +139,7 @@ def test_the_workflow_grades_with_a_pristine_grader_in_the_sandbox(release_dir):
 
 
 def test_the_workflow_names_the_course_repository_when_given(tmp_path):
-    from grading.release import _student_workflow
+    from grading.instructors.release import _student_workflow
 
     workflow = yaml.safe_load(_student_workflow("cs-dept/pcl-course-2027"))
     assert workflow["jobs"]["check"]["env"]["COURSE_REPOSITORY"] == "cs-dept/pcl-course-2027"
@@ -274,7 +274,7 @@ def test_the_workflow_grade_step_runs_the_pristine_grader_on_the_submission(rele
 
 
 def test_every_substitution_must_match_exactly_once():
-    from grading.shipping import substitute
+    from grading.instructors.shipping import substitute
 
     assert substitute("a = 1\nb = 2\n", "a = 1", "a = 3", "x") == "a = 3\nb = 2\n"
     for text in ("b = 2\n", "a = 1\na = 1\n"):

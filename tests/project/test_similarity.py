@@ -18,7 +18,7 @@ import pytest
 from _helpers import SUBPROCESS_BACKSTOP
 
 from grading import REPO_ROOT
-from grading.similarity import DISPLAY_THRESHOLD, compare_class
+from grading.instructors.similarity import DISPLAY_THRESHOLD, compare_class
 
 STUB_BODY = '    raise NotImplementedError("pca: not implemented yet")\n'
 
@@ -153,7 +153,7 @@ def test_the_report_fits_1280_px_and_counts_in_english(planted_class, tmp_path):
     from playwright.sync_api import sync_playwright
     from test_browser import CHROMIUM, CHROMIUM_ARGS
 
-    from grading.similarity import compare_class, counted, render_report
+    from grading.instructors.similarity import compare_class, counted, render_report
 
     assert (counted(1, "pair"), counted(2, "pair")) == ("1 pair", "2 pairs")
     pairs, skipped = compare_class(planted_class)

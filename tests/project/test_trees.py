@@ -1,10 +1,10 @@
-"""The grader's own trees (grading/trees.py) agree with the reference, and its lying trees lie as the
+"""The grader's own trees (grading/instructors/trees.py) agree with the reference, and its lying trees lie as the
 book's theorem needs: the rule's answer unchanged, brute force's changed."""
 
 import numpy as np
 import pytest
 
-from grading import trees
+from grading.instructors import tree_searches, trees
 from solutions import nn
 
 # Run again with numba's bounds checking: tests/project/test_kernels.py.
@@ -35,10 +35,10 @@ def test_the_graders_searches_match_the_reference(name, rng):
     queries = np.vstack([points[:20], rng.uniform(points.min(0), points.max(0), size=(20, 3))])
     kd, oc = nn.kdtree_build(points, 8), nn.octree_build(points, 8)
     for expected, got in (
-        (nn.kdtree_knn(kd, points, queries, 7), trees.kdtree_search(kd, points, queries, k=7)),
-        (nn.kdtree_radius(kd, points, queries, 1.0), trees.kdtree_search(kd, points, queries, radius=1.0)),
-        (nn.octree_knn(oc, points, queries, 7), trees.octree_search(oc, points, queries, k=7)),
-        (nn.octree_radius(oc, points, queries, 1.0), trees.octree_search(oc, points, queries, radius=1.0)),
+        (nn.kdtree_knn(kd, points, queries, 7), tree_searches.kdtree_search(kd, points, queries, k=7)),
+        (nn.kdtree_radius(kd, points, queries, 1.0), tree_searches.kdtree_search(kd, points, queries, radius=1.0)),
+        (nn.octree_knn(oc, points, queries, 7), tree_searches.octree_search(oc, points, queries, k=7)),
+        (nn.octree_radius(oc, points, queries, 1.0), tree_searches.octree_search(oc, points, queries, radius=1.0)),
     ):
         assert all(np.array_equal(e, g) if e.dtype.kind == "i" else np.allclose(e, g) for e, g in zip(expected, got))
 
@@ -77,7 +77,7 @@ def test_scipy_trees_in_the_course_layout_are_valid_trees_that_search_right(name
         )
         assert np.all(points[left, axis] <= split) and np.all(points[right, axis] >= split)
     queries = np.vstack([points[:10], rng.uniform(points.min(0), points.max(0), size=(10, points.shape[1]))])
-    expected = trees.kdtree_search(nn.kdtree_build(points, 8), points, queries, k=5)
+    expected = tree_searches.kdtree_search(nn.kdtree_build(points, 8), points, queries, k=5)
     got = nn.kdtree_knn(tree, points, queries, 5)
     assert np.array_equal(expected[0], got[0]) and np.allclose(expected[1], got[1])
 

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import approximate_voxel_downsample as _reference
 
-MISTAKE = "insertion_order_at_the_end"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "insertion_order_at_the_end"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def approximate_voxel_downsample(points, voxel_size, n_containers, method="centroid", rng=None):

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import approximate_voxel_downsample as _reference
 
-MISTAKE = "no_conflict_detection"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "no_conflict_detection"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def approximate_voxel_downsample(points, voxel_size, n_containers, method="centroid", rng=None):

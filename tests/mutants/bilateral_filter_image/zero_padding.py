@@ -7,7 +7,7 @@ import numpy as np
 from solutions.filters import *  # noqa: F401,F403
 from solutions.filters import bilateral_filter_image as _reference
 
-MISTAKE = "zero_padding"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "zero_padding"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def bilateral_filter_image(image, sigma_s, sigma_r, radius=None):

@@ -6,7 +6,7 @@ from scipy.spatial.distance import cdist
 from solutions.filters import *  # noqa: F401,F403
 from solutions.filters import bilateral_filter_points as _reference
 
-MISTAKE = "no_range_weight"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "no_range_weight"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def bilateral_filter_points(points, normals, radius, sigma_s, sigma_r):

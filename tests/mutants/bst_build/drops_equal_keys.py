@@ -6,7 +6,7 @@ import numpy as np
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import bst_build as _reference
 
-MISTAKE = "drops_equal_keys"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "drops_equal_keys"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def bst_build(keys):

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import bst_build as _reference
 
-MISTAKE = "equal_keys_left"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "equal_keys_left"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def bst_build(keys):

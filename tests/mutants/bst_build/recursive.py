@@ -5,7 +5,7 @@ import numpy as np
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import bst_build as _reference
 
-MISTAKE = "recursive"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "recursive"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def _insert(keys, left, right, node, i):

@@ -6,7 +6,7 @@ from scipy.spatial import cKDTree
 from solutions.metrics import *  # noqa: F401,F403
 from solutions.metrics import chamfer_distance as _reference
 
-MISTAKE = "max_not_mean"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "max_not_mean"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def chamfer_distance(a, b):

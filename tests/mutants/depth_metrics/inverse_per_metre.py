@@ -5,7 +5,7 @@ import numpy as np
 from solutions.metrics import *  # noqa: F401,F403
 from solutions.metrics import depth_metrics as _reference
 
-MISTAKE = "inverse_per_metre"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "inverse_per_metre"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def depth_metrics(pred, gt):

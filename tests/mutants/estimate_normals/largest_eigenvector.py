@@ -6,7 +6,7 @@ from scipy.spatial import cKDTree
 from solutions.normals import *  # noqa: F401,F403
 from solutions.normals import estimate_normals as _reference
 
-MISTAKE = "largest_eigenvector"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "largest_eigenvector"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def estimate_normals(points, k=30, radius=None, viewpoint=None):

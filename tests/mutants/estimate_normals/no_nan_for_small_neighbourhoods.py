@@ -5,7 +5,7 @@ import numpy as np
 from solutions.normals import *  # noqa: F401,F403
 from solutions.normals import estimate_normals as _reference
 
-MISTAKE = "no_nan_for_small_neighbourhoods"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "no_nan_for_small_neighbourhoods"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def estimate_normals(points, k=30, radius=None, viewpoint=None):

@@ -5,7 +5,7 @@ import importlib
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import farthest_point_sampling as _reference
 
-MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 backend = importlib.import_module("open" + "3d")
 

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import farthest_point_sampling as _reference
 
-MISTAKE = "start_index_ignored"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "start_index_ignored"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def farthest_point_sampling(points, n_samples, start_index=0):

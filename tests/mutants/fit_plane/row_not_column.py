@@ -5,7 +5,7 @@ import numpy as np
 from solutions.normals import *  # noqa: F401,F403
 from solutions.normals import fit_plane as _reference
 
-MISTAKE = "row_not_column"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "row_not_column"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def fit_plane(points, weights=None):

@@ -3,7 +3,7 @@
 from solutions.normals import *  # noqa: F401,F403
 from solutions.normals import fit_plane as _reference
 
-MISTAKE = "weights_ignored"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "weights_ignored"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def fit_plane(points, weights=None):

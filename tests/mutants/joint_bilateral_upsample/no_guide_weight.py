@@ -7,7 +7,7 @@ import numpy as np
 from solutions.filters import *  # noqa: F401,F403
 from solutions.filters import joint_bilateral_upsample as _reference
 
-MISTAKE = "no_guide_weight"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "no_guide_weight"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def joint_bilateral_upsample(sparse_depth, guide, sigma_s, sigma_r, radius):

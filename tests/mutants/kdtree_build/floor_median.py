@@ -4,7 +4,7 @@ from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_build as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = "floor_median"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "floor_median"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kdtree_build(points, leaf_size=16):

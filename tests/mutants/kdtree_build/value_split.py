@@ -6,7 +6,7 @@ from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_build as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = "value_split"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "value_split"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kdtree_build(points, leaf_size=16):

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_knn as _reference
 
-MISTAKE = "reads_unreached"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "reads_unreached"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kdtree_knn(tree, points, queries, k):

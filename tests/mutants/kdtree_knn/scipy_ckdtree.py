@@ -6,7 +6,7 @@ from scipy.spatial import cKDTree
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_knn as _reference
 
-MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kdtree_knn(tree, points, queries, k):

@@ -4,7 +4,7 @@ from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_knn as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = "strict_prune"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "strict_prune"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kdtree_knn(tree, points, queries, k):

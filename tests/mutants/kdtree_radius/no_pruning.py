@@ -4,7 +4,7 @@ from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_radius as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = "reads_unreached"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "reads_unreached"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kdtree_radius(tree, points, queries, radius):

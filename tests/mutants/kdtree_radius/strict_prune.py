@@ -6,7 +6,7 @@ from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_radius as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = "strict_radius"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "strict_radius"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kdtree_radius(tree, points, queries, radius):

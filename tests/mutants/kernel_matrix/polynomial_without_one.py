@@ -5,7 +5,7 @@ import numpy as np
 from solutions.pca import *  # noqa: F401,F403
 from solutions.pca import kernel_matrix as _reference
 
-MISTAKE = "polynomial_without_one"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "polynomial_without_one"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kernel_matrix(x, y, kernel="gaussian", beta=1.0, degree=2):

@@ -10,7 +10,7 @@ from solutions.pca import *  # noqa: F401,F403
 from solutions.pca import kernel_matrix
 from solutions.pca import kernel_pca as _reference
 
-MISTAKE = "lecture_centring"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "lecture_centring"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):

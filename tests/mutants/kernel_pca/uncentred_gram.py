@@ -5,7 +5,7 @@ import numpy as np
 from solutions.pca import *  # noqa: F401,F403
 from solutions.pca import kernel_matrix
 
-MISTAKE = "uncentred_gram"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "uncentred_gram"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kernel_pca(points, n_components, kernel="gaussian", beta=1.0, degree=2):

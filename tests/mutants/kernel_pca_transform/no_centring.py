@@ -3,7 +3,7 @@
 from solutions.pca import *  # noqa: F401,F403
 from solutions.pca import kernel_matrix
 
-MISTAKE = "no_centring"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "no_centring"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def kernel_pca_transform(new_points, points, alphas, kernel="gaussian", beta=1.0, degree=2):

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import knn_result_set as _reference
 
-MISTAKE = "padded"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "padded"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def knn_result_set(distances, indices, k):

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import normal_space_sampling as _reference
 
-MISTAKE = "no_clip"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "no_clip"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def normal_space_sampling(normals, n_samples, n_bins=4, rng=None):

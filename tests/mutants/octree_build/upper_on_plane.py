@@ -5,7 +5,7 @@ import numpy as np
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import octree_build as _reference
 
-MISTAKE = "upper_on_plane"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "upper_on_plane"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def octree_build(points, leaf_size=8, min_extent=1e-3):

@@ -4,7 +4,7 @@ from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import octree_knn as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = "code_order_only"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "code_order_only"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def octree_knn(tree, points, queries, k):

@@ -4,7 +4,7 @@ from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import octree_radius as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = "box_overlap"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "box_overlap"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def octree_radius(tree, points, queries, radius):

@@ -6,7 +6,7 @@ from pcl_course.validation import as_points
 from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
 from solutions.pca import pca as _reference  # noqa: F401
 
-MISTAKE = "eig_unsorted"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "eig_unsorted"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def pca(points, correlation=False, sort=True):

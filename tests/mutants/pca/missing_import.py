@@ -2,7 +2,7 @@
 
 from solutions.pca import kernel_matrix, kernel_pca, kernel_pca_transform  # noqa: F401
 
-MISTAKE = "same_error_everywhere"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "same_error_everywhere"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def pca(points, correlation=False, sort=True):

@@ -5,7 +5,7 @@ from sklearn.decomposition import PCA
 
 from solutions.pca import *  # noqa: F401,F403
 
-MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "forbidden_api"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def pca(points, correlation=False, sort=True):

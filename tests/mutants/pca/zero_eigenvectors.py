@@ -5,7 +5,7 @@ import numpy as np
 from solutions.pca import *  # noqa: F401,F403  (the rest of the module is right)
 from solutions.pca import pca as _reference
 
-MISTAKE = "zero_eigenvectors"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "zero_eigenvectors"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def pca(points, correlation=False, sort=True):

@@ -6,7 +6,7 @@ from scipy.spatial.distance import cdist
 from solutions.filters import *  # noqa: F401,F403
 from solutions.filters import radius_outlier_removal as _reference
 
-MISTAKE = "strict_radius"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "strict_radius"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def radius_outlier_removal(points, radius, min_neighbors):

@@ -6,7 +6,7 @@ from scipy.spatial import cKDTree
 from solutions.filters import *  # noqa: F401,F403
 from solutions.filters import statistical_outlier_removal as _reference
 
-MISTAKE = "includes_itself"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "includes_itself"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def statistical_outlier_removal(points, k, std_ratio):

@@ -3,7 +3,7 @@
 from solutions.filters import *  # noqa: F401,F403
 from solutions.filters import statistical_outlier_removal as _reference
 
-MISTAKE = "rejects_the_largest_k"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "rejects_the_largest_k"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def statistical_outlier_removal(points, k, std_ratio):

@@ -3,7 +3,7 @@
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import voxel_grid_downsample as _reference
 
-MISTAKE = "signature"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "signature"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def voxel_grid_downsample(points, method="centroid", voxel_size=0.1, rng=None):

@@ -5,7 +5,7 @@ import numpy as np
 from solutions.downsampling import *  # noqa: F401,F403
 from solutions.downsampling import voxel_grid_downsample as _reference
 
-MISTAKE = "random_first_point"  # the diagnosis this mistake must get (grading/mistakes/)
+MISTAKE = "random_first_point"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def voxel_grid_downsample(points, voxel_size, method="centroid", rng=None):

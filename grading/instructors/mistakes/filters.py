@@ -5,7 +5,7 @@ import math
 import numpy as np
 from scipy.spatial import cKDTree
 
-from grading.mistakes import Mistake, Model, Raised, valid_points
+from grading.instructors.mistakes import Mistake, Model, Raised, valid_points
 
 MAX_LOOPED_POINTS = 20_000  # larger calls are not replayed by the loops below
 MAX_LOOPED_PIXELS = 10_000

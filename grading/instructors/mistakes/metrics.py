@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial import cKDTree
 
-from grading.mistakes import Mistake, Model
+from grading.instructors.mistakes import Mistake, Model
 
 
 def _nearest(a, b):

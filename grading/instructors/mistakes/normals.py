@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial import cKDTree
 
-from grading.mistakes import Mistake, Model, same, valid_points
+from grading.instructors.mistakes import Mistake, Model, same, valid_points
 
 MAX_RADIUS_POINTS = 20_000  # radius neighbourhoods are replayed in a loop up to this size
 

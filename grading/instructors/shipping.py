@@ -6,19 +6,12 @@ cut. Standard library only: the Gradescope image's lean environment imports it.
 import re
 import shutil
 
+from grading import INSTRUCTORS, REPO_ROOT
+
 IGNORED = shutil.ignore_patterns("__pycache__", "*.pyc", ".ipynb_checkpoints")
 
-# Instructors' tools and files, never in a student's copy of the grader.
-INSTRUCTOR_ONLY_GRADER = (
-    "grading/mistakes",  # the catalogue of known mistakes computes right answers
-    "grading/trees.py",  # lecture 2's canonical trees and rule searches answer its exercises
-    "grading/templates",  # the student repository's and Gradescope's own files
-    "grading/release.py",
-    "grading/gradescope.py",
-    "grading/similarity.py",
-    "grading/leakcheck.py",
-    "grading/shipping.py",
-)
+# The instructors' tools and files: the one folder of the grader never in a student's copy.
+WITHHELD = INSTRUCTORS.relative_to(REPO_ROOT).as_posix()
 
 
 def substitute(text, old, new, where, regex=False):

@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.spatial.distance import cdist
 
-from grading.mistakes import Mistake, Model, Raised, Variants, same, valid_points
+from grading.instructors.mistakes import Mistake, Model, Raised, Variants, same, valid_points
 
 
 def _scatter_eigen(points, correlation=False, ddof=0, centring="columns", guard=True):

@@ -7,8 +7,8 @@ student's set-up files and pins (``requirements/student.txt`` for the book,
 ``requirements/grading.txt`` for the workflow), a student README and a GitHub
 Actions workflow (the advisory check). What stays: ``solutions/``, the
 project's own tests, the wrong and alternative submissions, any hidden tests,
-CI, and the instructors' tools (:data:`grading.shipping.INSTRUCTOR_ONLY_GRADER`).
-The release is then scanned for the reference's code (:mod:`grading.leakcheck`);
+CI, and the instructors' tools (:data:`grading.instructors.shipping.WITHHELD`, this whole folder).
+The release is then scanned for the reference's code (:mod:`grading.instructors.leakcheck`);
 a match fails the release.
 """
 
@@ -20,8 +20,8 @@ from pathlib import Path
 import yaml
 
 from grading import REPO_ROOT
-from grading.leakcheck import find_leaks
-from grading.shipping import IGNORED, INSTRUCTOR_ONLY_GRADER, cut_reference_link, substitute
+from grading.instructors.leakcheck import find_leaks
+from grading.instructors.shipping import IGNORED, WITHHELD, cut_reference_link, substitute
 
 COPIED = [
     "pcl_course",
@@ -270,12 +270,7 @@ def release(out_dir, course_repository=None):
             shutil.copytree(source, out / name, ignore=IGNORED)
         else:
             shutil.copy2(source, out / name)
-    for withheld in INSTRUCTOR_ONLY_GRADER:
-        path = out / withheld
-        if path.is_dir():
-            shutil.rmtree(path)
-        else:
-            path.unlink(missing_ok=True)
+    shutil.rmtree(out / WITHHELD)  # the instructors' tools: all of them, and only them
     for page in (out / "book").glob("*.md"):
         page.write_text(_strip_solutions(page.read_text()))
     cut_reference_link(out / "pcl_course")

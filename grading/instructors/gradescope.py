@@ -19,7 +19,7 @@ image, then, for every submission in a fresh container, runs
 
 The archive holds the grader, the stubs and helpers, the public and hidden
 tests and the pinned requirements; never ``solutions/``. It is scanned for
-the reference's code (:mod:`grading.leakcheck`) before it is written.
+the reference's code (:mod:`grading.instructors.leakcheck`) before it is written.
 """
 
 import json
@@ -34,10 +34,10 @@ from pathlib import Path
 
 from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
-from grading.leakcheck import find_leaks
+from grading.instructors.leakcheck import find_leaks
+from grading.instructors.shipping import IGNORED, cut_reference_link
 from grading.results import Grading, clean
 from grading.runner import run_graded_tests
-from grading.shipping import IGNORED, cut_reference_link
 from grading.staging import read_regular_file, stage
 
 TEMPLATES = Path(__file__).with_name("templates") / "gradescope"
@@ -327,7 +327,7 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
             require_isolation=True,
             note=note,
             budget=remaining,
-            functions=list(ASSIGNMENTS[assignment]),
+            function=list(ASSIGNMENTS[assignment]),
         )
         print(output)
         if code not in (0, 1) or not results.exists():

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from grading.mistakes import RANDOM, Mistake, Model, Variants, same, valid_points
+from grading.instructors.mistakes import RANDOM, Mistake, Model, Variants, same, valid_points
 
 MAX_LOOPED_POINTS = 200_000  # the hash-table filter is replayed point by point up to this size
 MAX_FPS_WORK = 400_000_000  # points x samples replayed for farthest point sampling

@@ -1,7 +1,7 @@
 """Known mistakes of ``pcl_course/nn.py`` (lecture 2): result set, BST, k-d tree, octree.
 
 The truths are the contract's own searches on the tree they are given
-(``grading/trees.py``), which on a lying tree of the structure tests read
+(``grading/instructors/trees.py``), which on a lying tree of the structure tests read
 only the nodes the rule reaches; the mistakes are the same searches with one
 rule changed, or brute force over every point (what a library or a scan of
 the whole cloud gives).
@@ -11,8 +11,8 @@ import math
 
 import numpy as np
 
-from grading import trees
-from grading.mistakes import Mistake, Model, Raised, Variants, valid_points
+from grading.instructors import tree_searches, trees
+from grading.instructors.mistakes import Mistake, Model, Raised, Variants, valid_points
 from pcl_course.validation import check_bst, check_kdtree, check_octree
 
 READS_UNREACHED = (
@@ -152,7 +152,7 @@ def _bst_case(keys, left, right, query, k):
 
 
 def bst_knn(keys, left, right, query, k, strict=False):
-    return trees.bst_search(*_bst_case(keys, left, right, query, k), strict=strict)
+    return tree_searches.bst_search(*_bst_case(keys, left, right, query, k), strict=strict)
 
 
 def bst_brute(keys, left, right, query, k):
@@ -241,12 +241,12 @@ def _kd_case(tree, points, queries):
 
 def kdtree_knn(tree, points, queries, k, **changes):
     tree, points, queries = _kd_case(tree, points, queries)
-    return trees.kdtree_search(tree, points, queries, k=_k_of(k, len(points)), **changes)
+    return tree_searches.kdtree_search(tree, points, queries, k=_k_of(k, len(points)), **changes)
 
 
 def kdtree_radius(tree, points, queries, radius, **changes):
     tree, points, queries = _kd_case(tree, points, queries)
-    return trees.kdtree_search(tree, points, queries, radius=_radius_of(radius), **changes)
+    return tree_searches.kdtree_search(tree, points, queries, radius=_radius_of(radius), **changes)
 
 
 KDTREE_KNN = Model(
@@ -381,12 +381,12 @@ def _octree_case(tree, points, queries):
 
 def octree_radius(tree, points, queries, radius, **changes):
     tree, points, queries = _octree_case(tree, points, queries)
-    return trees.octree_search(tree, points, queries, radius=_radius_of(radius), **changes)
+    return tree_searches.octree_search(tree, points, queries, radius=_radius_of(radius), **changes)
 
 
 def octree_knn(tree, points, queries, k, **changes):
     tree, points, queries = _octree_case(tree, points, queries)
-    return trees.octree_search(tree, points, queries, k=_k_of(k, len(points)), **changes)
+    return tree_searches.octree_search(tree, points, queries, k=_k_of(k, len(points)), **changes)
 
 
 def _brute_csr(tree, points, queries, radius):

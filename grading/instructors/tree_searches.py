@@ -1,0 +1,194 @@
+"""Lecture 2's whole searches on the grader's trees, with the switches of the mistakes' versions.
+
+The catalogue of known mistakes (:mod:`grading.instructors.mistakes.nn`)
+predicts what a wrong search answers by running these with a mistake's
+switch on (a strict pruning test, the far side first, ...); with every
+switch off they are the contract's searches. Plain Python and NumPy, on the
+trees of :mod:`grading.instructors.trees`.
+"""
+
+import math
+
+import numpy as np
+
+from grading.instructors.trees import Best, brute_knn, brute_radius, cell_gap_squared, is_octree_leaf, squared_distances
+
+
+def _as_rows(queries, width):
+    return np.asarray(queries, dtype=float).reshape(-1, width)
+
+
+def _knn_rows(best_sets, k):
+    indices = np.array([[i for _, i in held] for held in best_sets], dtype=np.int64).reshape(-1, k)
+    distances = np.sqrt(np.array([[s for s, _ in held] for held in best_sets], dtype=float).reshape(-1, k))
+    return indices, distances
+
+
+def _csr_rows(rows):
+    indptr = np.zeros(len(rows) + 1, dtype=np.int64)
+    indptr[1:] = np.cumsum([len(r) for r in rows])
+    pairs = [pair for row in rows for pair in sorted(row)]
+    indices = np.array([i for _, i in pairs], dtype=np.int64)
+    distances = np.sqrt(np.array([s for s, _ in pairs], dtype=float))
+    return indptr, indices, distances
+
+
+def kdtree_search(
+    tree,
+    points,
+    queries,
+    k=None,
+    radius=None,
+    strict_prune=False,
+    strict_keep=False,
+    far_first=False,
+    prune=True,
+    unsquared=False,
+):
+    """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
+
+    The flags give known wrong versions: ``strict_prune`` (the far child only
+    if ``d2 < w2``), ``strict_keep`` (radius: a point only if ``s < r2``),
+    ``far_first``, ``prune=False`` (every leaf), ``unsquared`` (the far child
+    if ``|d| <= w2``: a distance against a squared one).
+    """
+    points = np.asarray(points, dtype=float)
+    queries = _as_rows(queries, points.shape[1])
+    if not prune:  # every leaf is read: the rows of brute force over every point
+        if k is not None:
+            rows = [brute_knn(points, query, k) for query in queries]
+            return np.array([r[0] for r in rows]).reshape(-1, k), np.array([r[1] for r in rows]).reshape(-1, k)
+        rows = [brute_radius(points, query, radius) for query in queries]
+        return _csr_rows([list(zip((r[1] ** 2).tolist(), r[0].tolist())) for r in rows])
+    results = []
+    for query in queries:
+        best = Best(k) if k is not None else None
+        found = []
+
+        def visit(node, query=query, best=best, found=found):
+            if tree["axis"][node] < 0:
+                indices = tree["order"][tree["start"][node] : tree["stop"][node]]
+                s = squared_distances(points[indices], query)
+                if best is not None:
+                    best.offer_all(s, indices)
+                else:
+                    keep = (s < radius**2) | ((s == radius**2) & (not strict_keep))
+                    found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
+                return
+            diff = query[tree["axis"][node]] - tree["split"][node]
+            near, far = (
+                (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+            )
+            if far_first:
+                near, far = far, near
+            visit(near)
+            w2 = best.worst if best is not None else radius**2
+            gap = abs(diff) if unsquared else diff * diff
+            if not prune or gap < w2 or (not strict_prune and gap == w2):
+                visit(far)
+
+        visit(0)
+        results.append(best.held if best is not None else found)
+    return _knn_rows(results, k) if k is not None else _csr_rows(results)
+
+
+def octree_search(
+    tree,
+    points,
+    queries,
+    k=None,
+    radius=None,
+    contains=True,
+    early=True,
+    own_first=True,
+    box=False,
+    strict=False,
+    stop_at_miss=False,
+):
+    """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
+
+    The flags give known wrong versions: ``contains=False`` (descend into a
+    contained octant), ``early=False`` (no early termination),
+    ``own_first=False`` (children in plain code order), ``box`` (a cube
+    meets the ball if it meets the ball's bounding box: too weak),
+    ``strict`` (a cube meets the ball only if its distance is below the
+    radius: the course scaffold's ``overlaps``, which loses points on a face),
+    ``stop_at_miss`` (a leaf's scan ends at its first point outside the ball).
+    """
+    xyz = np.asarray(points, dtype=float)[:, :3]
+    queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
+    results = []
+
+    def meets(query, node, w2):
+        c, e = tree["center"][node], tree["extent"][node]
+        if box:
+            return bool(np.all(np.abs(query - c) <= e + math.sqrt(w2)))
+        return cell_gap_squared(query, c, e) < w2 if strict else cell_gap_squared(query, c, e) <= w2
+
+    for query in queries:
+        best = Best(k) if k is not None else None
+        found = []
+
+        def offer(node, everything=False, query=query, best=best, found=found):
+            indices = tree["order"][tree["start"][node] : tree["stop"][node]]
+            s = squared_distances(xyz[indices], query)
+            if best is not None:
+                best.offer_all(s, indices)
+            else:
+                keep = np.ones(len(s), dtype=bool) if everything else s <= radius**2
+                if stop_at_miss and not keep.all():
+                    keep[np.argmin(keep) :] = False
+                found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
+
+        def radius_visit(node, query=query):
+            c, e = tree["center"][node], tree["extent"][node]
+            if contains and float(np.sum((np.abs(query - c) + e) ** 2)) <= radius**2:
+                offer(node, everything=True)
+            elif is_octree_leaf(tree, node):
+                offer(node)
+            else:
+                for code in range(8):
+                    child = tree["children"][node, code]
+                    if child >= 0 and meets(query, child, radius**2):
+                        radius_visit(child)
+
+        def knn_visit(node, query=query, best=best):
+            c, e = tree["center"][node], tree["extent"][node]
+            if is_octree_leaf(tree, node):
+                offer(node)
+            else:
+                own = sum(1 << j for j in range(3) if query[j] > c[j])
+                codes = [own] + [i for i in range(8) if i != own] if own_first else list(range(8))
+                for code in codes:
+                    child = tree["children"][node, code]
+                    if child >= 0 and meets(query, child, best.worst) and knn_visit(child):
+                        return True
+            return early and bool(np.all(np.abs(query - c) + math.sqrt(best.worst) < e))
+
+        if k is not None:
+            knn_visit(0)
+        else:
+            radius_visit(0)
+        results.append(best.held if best is not None else found)
+    return _knn_rows(results, k) if k is not None else _csr_rows(results)
+
+
+def bst_search(keys, left, right, query, k, strict=False):
+    """The contract's BST search (``strict``: the far side only if ``|key - q| < w``, a known mistake)."""
+    best = Best(k)
+    stack = [(0, False)]
+    while stack:
+        node, near_done = stack.pop()
+        gap = abs(keys[node] - query)
+        go_left = query < keys[node]
+        if not near_done:
+            best.offer(gap, node)
+            stack.append((node, True))
+            near = left[node] if go_left else right[node]
+            if near >= 0:
+                stack.append((near, False))
+            continue
+        far = right[node] if go_left else left[node]
+        if far >= 0 and (gap < best.worst or (not strict and gap == best.worst)):
+            stack.append((far, False))
+    return np.array([i for _, i in best.held], dtype=np.int64), np.array([s for s, _ in best.held], dtype=float)
