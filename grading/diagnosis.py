@@ -338,9 +338,19 @@ def _one_rule(function, calls, outcomes, failed, context):
 def same(a, b, rtol=1e-6, atol=1e-8):
     """Whether two answers are equal: arrays (NaN equal to NaN), numbers, tuples, dicts."""
     if isinstance(a, tuple) or isinstance(b, tuple):
-        return isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b) and all(map(same, a, b))
+        return (
+            isinstance(a, tuple)
+            and isinstance(b, tuple)
+            and len(a) == len(b)
+            and all(same(x, y, rtol, atol) for x, y in zip(a, b))
+        )
     if isinstance(a, dict) or isinstance(b, dict):
-        return isinstance(a, dict) and isinstance(b, dict) and set(a) == set(b) and all(same(a[k], b[k]) for k in a)
+        return (
+            isinstance(a, dict)
+            and isinstance(b, dict)
+            and set(a) == set(b)
+            and all(same(a[k], b[k], rtol, atol) for k in a)
+        )
     try:
         a, b = np.asarray(a), np.asarray(b)
     except Exception:
