@@ -443,17 +443,18 @@ def test_known_mistake_guards_drop_a_test_that_both_matches_and_contradicts():
 
 def test_known_mistake_ignores_calls_it_cannot_compare():
     """Calls whose truth raises (an input the contract rejects), whose arguments were not kept or do not
-    bind, and mistakes whose prediction raises: no evidence either way."""
-    empty = np.zeros((0, 3))
+    bind: no evidence either way; a mistake whose prediction raises does not apply there."""
+    flat = np.arange(3.0)  # 1-D: the truth raises ValueError, the sums are 3.0
     calls = [
-        answered("t1", empty, sums(empty)),  # the truth raises ValueError
+        answered("t1", flat, sums(flat)),
         Call("t1", (cloud(3),), {}, result=sums(cloud(3)), kept=False),
         Call("t1", (cloud(3),), {"nonsense": 1}, result=sums(cloud(3))),
     ]
     assert run(_known_mistake, calls, failed("t1"), model=catalogue(SUMS)) is None
-    broken = Mistake("broken", "never", lambda points, **_: 1 / 0)
-    calls = [answered("t1", cloud(3), sums(cloud(3)))]
-    assert run(_known_mistake, calls, failed("t1"), model=catalogue(broken)) is None
+    # A prediction that raises (here on clouds of two points or fewer): the mistake does not apply there.
+    fragile = Mistake("fragile_sums", "sums", lambda points, **_: sums(points) if len(points) > 2 else 1 / 0)
+    calls = [answered("t1", cloud(3), sums(cloud(3))), answered("t2", cloud(2), np.full(3, 99.0))]
+    assert run(_known_mistake, calls, failed("t1", "t2"), model=catalogue(fragile)).explains == ("t1",)
 
 
 def half_sums(points, **_):
@@ -557,6 +558,19 @@ def test_random_a_match_is_evidence_only_when_chance_could_not_give_it(p, clouds
     assert (found is not None and found.explains == ("t1",)) == named
 
 
+def test_a_right_answer_contradicts_a_prediction_that_chance_could_give():
+    """A prediction that a right answer may equal by chance (a random method's): a right answer that
+    differs from it contradicts it, rather than showing the mistake is not on that code path."""
+    guessed = Mistake("sums_by_chance", "sums", lambda points, **_: Guess(sums(points), 1e-4), same=guess_same)
+    calls = [answered("t1", cloud(3), sums(cloud(3))), answered("t2", cloud(2), means(cloud(2)))]
+    assert run(_known_mistake, calls, {**failed("t1"), **passed("t2")}, model=catalogue(guessed)) is None
+    assert run(_known_mistake, calls[:1], {**failed("t1"), **passed("t2")}, model=catalogue(guessed)).id == (
+        "sums_by_chance"
+    )
+    # A deterministic prediction: the right answer only shows the mistake is not on that path.
+    assert run(_known_mistake, calls, {**failed("t1"), **passed("t2")}, model=catalogue(SUMS)).id == "sums"
+
+
 def test_random_a_mismatch_contradicts_the_mistake():
     """Against a random truth, an answer that differs from the prediction contradicts it: one match and
     one mismatch leave it unnamed."""
@@ -610,7 +624,8 @@ def test_explained_line_counts_the_tests_it_explains_of_several():
         (np.zeros(3), np.zeros((1, 3)), False),  # shapes differ
         (np.array([1, 2], dtype=np.int64), np.array([1.0, 2.0]), True),  # values, not dtypes
         (np.array([1, 2], dtype=np.int64), np.array([1, 2], dtype=np.uint8), True),
-        (np.array([1, 2], dtype=np.int64), np.array([1, 3], dtype=np.int64), False),  # integers: exact
+        (np.array([1, 2], dtype=np.int64), np.array([1, 3], dtype=np.int64), False),
+        (np.array([10**9], dtype=np.int64), np.array([10**9 + 1], dtype=np.int64), False),  # integers: exact
         (np.float32(0.1), 0.1, True),
         (np.array([True, False]), np.array([True, True]), False),
         ((np.zeros(2), (1.0, np.ones(3))), (np.zeros(2), (1.0, np.ones(3))), True),  # nested tuples
