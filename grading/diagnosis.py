@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, config
+from grading.forbidden import scan_source
 
 # Kinds of test failure, recorded by the plugin for each failed test.
 NOT_IMPLEMENTED, FORBIDDEN, REFUSED, SANDBOX = "not implemented", "forbidden", "refused", "sandbox"
@@ -180,6 +181,17 @@ _IMPORT_FIXES = {
 }
 
 
+def _import_hint(name, module):
+    """What to add to a NameError of ``name`` in ``module``: the import that defines it, unless the
+    forbidden scan (with the module's own list) would refuse that import there."""
+    line = _IMPORT_FIXES.get(name)
+    if line is None:
+        return ""
+    if scan_source(line, extra=config.FORBIDDEN_IN_MODULE.get(module, ())):
+        return f": {module}.py may not import `{name}` (forbidden there): write that code yourself, no library's"
+    return f": add `{line}` at the top of {module}.py"
+
+
 def _same_error_everywhere(function, calls, outcomes, failed, context):
     if len(calls) < 2 or not all(c.raised for c in calls):
         return None
@@ -193,8 +205,7 @@ def _same_error_everywhere(function, calls, outcomes, failed, context):
     message = f"every call raised {error_type}{shown}{place}"
     if error_type == "NameError" and shown:
         name = shown.split("'")[1] if shown.count("'") >= 2 else ""
-        if name in _IMPORT_FIXES:
-            message += f": add `{_IMPORT_FIXES[name]}` at the top of {GRADED_FUNCTIONS[function]}.py"
+        message += _import_hint(name, GRADED_FUNCTIONS[function])
     explained = tuple(t for t in failed if any(c.test == t for c in calls))
     return Diagnosis("same_error_everywhere", message, explained)
 

@@ -11,10 +11,15 @@ explains) and one where it must stay silent; for the catalogue, each guard
 that keeps a mistake from being named, at and just below its threshold.
 """
 
+import re
+
 import numpy as np
 import pytest
 
+from grading import GRADED_FUNCTIONS
+from grading.config import EXERCISE_MODULES, FORBIDDEN_IN_MODULE
 from grading.diagnosis import (
+    _IMPORT_FIXES,
     ASSERTION,
     CHANCE_LIMIT,
     CHECK,
@@ -43,6 +48,7 @@ from grading.diagnosis import (
     explained_line,
     same,
 )
+from grading.forbidden import scan_source
 from grading.mistakes import Mistake, Model
 
 FUNCTION = "pca"
@@ -647,3 +653,50 @@ def test_same_passes_its_tolerances_into_tuples_and_dicts():
     a, b = np.array([1.0, 2.0]), np.array([1.0, 2.001])
     assert same(a, b, rtol=1e-2) and same((a, (a,)), (b, (b,)), rtol=1e-2) and same({"x": a}, {"x": b}, rtol=1e-2)
     assert not same((a,), (b,))
+
+
+# -- import hints never suggest a forbidden module -------------------------------------------------
+
+
+def hint_of(message):
+    """The import line a diagnosis suggests, or None."""
+    found = re.search(r"add `([^`]*)` at the top of", message)
+    return found.group(1) if found else None
+
+
+def function_of(module):
+    return next(f for f, m in GRADED_FUNCTIONS.items() if m == module)
+
+
+@pytest.mark.parametrize("module", EXERCISE_MODULES)
+@pytest.mark.parametrize("name", sorted(_IMPORT_FIXES))
+def test_no_import_hint_is_forbidden_in_its_module(name, module):
+    """For every hint and every exercise module, the import suggested for a NameError is one the forbidden
+    scan allows there (with the module's own list); where it allows it, the hint is given."""
+    function = function_of(module)
+    calls = [name_error(t, name, where=f"{module}.py:3") for t in ("t1", "t2")]
+    found = diagnose(function, calls, failed("t1", "t2"))
+    assert found.id == "same_error_everywhere" and f"name '{name}' is not defined" in found.message
+    line = hint_of(found.message)
+    extra = FORBIDDEN_IN_MODULE.get(module, ())
+    if scan_source(_IMPORT_FIXES[name], extra=extra):
+        assert line is None and "no library" in found.message, found.message
+    else:
+        assert line == _IMPORT_FIXES[name] and f"at the top of {module}.py" in found.message
+    if line is not None:
+        assert scan_source(line, extra=extra) == [], line
+
+
+def test_a_missing_ckdtree_in_nn_gets_no_scipy_hint():
+    """``cKDTree`` not defined in nn.py: the line says the name is not defined, that nn.py may not import it
+    and that the code must be the student's own, and suggests no scipy.spatial; in normals.py, where
+    scipy.spatial is allowed, the import is still suggested."""
+    calls = [name_error(t, "cKDTree", where="nn.py:40") for t in ("t1", "t2")]
+    found = diagnose("kdtree_knn", calls, failed("t1", "t2"))
+    assert found.id == "same_error_everywhere" and found.explains == ("t1", "t2")
+    assert "scipy" not in found.message and "add `" not in found.message
+    assert found.message.startswith("every call raised NameError: name 'cKDTree' is not defined at nn.py:40: ")
+    assert "nn.py may not import `cKDTree`" in found.message and "yourself" in found.message
+    assert "no library" in found.message
+    found = diagnose("estimate_normals", calls, failed("t1", "t2"))
+    assert "add `from scipy.spatial import cKDTree` at the top of normals.py" in found.message
