@@ -133,16 +133,22 @@ def bind(function, call):
 
 
 def _parameters_in_source(source, function):
-    """The parameter names of ``def function(...)`` in a module's source, or None."""
+    """The parameter names of ``def function(...)`` in a module's source, or None.
+
+    The last top-level definition is the one the module binds. None too for a
+    ``*args`` or ``**kwargs``: what such a function accepts is not in its names.
+    """
     try:
         tree = ast.parse(source)
     except SyntaxError:
         return None
-    for node in tree.body:
-        if isinstance(node, ast.FunctionDef) and node.name == function:
-            arguments = node.args
-            return [a.arg for a in arguments.posonlyargs + arguments.args + arguments.kwonlyargs]
-    return None
+    defined = [node for node in tree.body if isinstance(node, ast.FunctionDef) and node.name == function]
+    if not defined:
+        return None
+    arguments = defined[-1].args
+    if arguments.vararg or arguments.kwarg:
+        return None
+    return [a.arg for a in arguments.posonlyargs + arguments.args + arguments.kwonlyargs]
 
 
 # -- the generic findings ---------------------------------------------------------------

@@ -233,8 +233,9 @@ def test_extra_columns_is_silent_for_a_function_without_points():
 
 
 def test_signature_names_parameters_in_another_order():
-    """``def pca(sort, points, correlation=False)``: both orders named, the tests that errored explained."""
-    sources = {"pca": "def pca(sort, points, correlation=False):\n    return sort\n"}
+    """``def pca(sort, points, correlation=False)`` (the last definition): both orders named, the tests that
+    errored explained."""
+    sources = {"pca": "def pca(points):\n    pass\n\n\ndef pca(sort, points, correlation=False):\n    return sort\n"}
     outcomes = {**failed("t1", kind=ERROR), **failed("t2", kind=SANDBOX), **failed("t3")}
     found = run(_signature, [], outcomes, sources=sources)
     assert found.id == "signature" and found.explains == ("t1", "t2")
@@ -248,12 +249,16 @@ def test_signature_names_parameters_in_another_order():
         ("def pca(sort, points, correlation=False):\n    pass\n", ASSERTION),  # no test errored
         ("def pca(sort, points, correlation=False:\n", ERROR),  # cannot be parsed
         ("def other(sort, points):\n    pass\n", ERROR),  # no such function
+        ("def pca(sort, points):\n    pass\n\n\ndef pca(points, correlation=False, sort=True):\n    pass\n", ERROR),
+        ("def pca(*args, **kwargs):\n    pass\n", ERROR),  # takes any call
+        ("def pca(points, *args):\n    pass\n", ERROR),
     ],
-    ids=["extra parameter", "no error", "syntax error", "no def"],
+    ids=["extra parameter", "no error", "syntax error", "no def", "redefined", "any call", "varargs"],
 )
 def test_signature_is_silent_for_the_contracts_order_or_without_errors(source, kind):
-    """The contract's parameters then more, no test that errored, a source that does not parse
-    or does not define the function: no finding."""
+    """The contract's parameters then more, no test that errored, a source that does not parse or does not
+    define the function, a wrong first definition that a right one replaces, a ``*args`` or ``**kwargs``
+    (what it accepts is not in its names): no finding."""
     assert run(_signature, [], failed("t1", kind=kind), sources={"pca": source}) is None
     assert run(_signature, [], failed("t1", kind=ERROR)) is None  # no source at all
 
