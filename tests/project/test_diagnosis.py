@@ -55,7 +55,7 @@ FUNCTION = "pca"
 
 
 def cloud(n, columns=3, shift=0.0):
-    """n points, all different, that no two clouds of different ``shift`` share."""
+    """n different points of ``columns`` coordinates; another ``shift``, other arguments."""
     return np.arange(n * columns, dtype=float).reshape(n, columns) + shift
 
 
@@ -228,7 +228,10 @@ def test_extra_columns_is_silent_unless_only_every_wide_cloud_crashes(calls):
 
 def test_extra_columns_is_silent_for_a_function_without_points():
     """chamfer_distance(a, b) has no ``points``: the rule does not apply."""
-    calls = [Call("t1", (cloud(2), cloud(2)), {}, result=0.0), Call("t2", (cloud(2, 5), cloud(2, 5)), {}, "x", "E")]
+    calls = [
+        Call("t1", (cloud(2), cloud(2)), {}, result=0.0),
+        Call("t2", (cloud(2, 5), cloud(2, 5)), {}, error_type="IndexError", error="index 3"),
+    ]
     assert run(_extra_columns, calls, failed("t2"), function="chamfer_distance") is None
 
 
