@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, config
+from grading.forbidden import scan_source
 
 # Kinds of test failure, recorded by the plugin for each failed test.
 NOT_IMPLEMENTED, FORBIDDEN, REFUSED, SANDBOX = "not implemented", "forbidden", "refused", "sandbox"
@@ -132,16 +133,22 @@ def bind(function, call):
 
 
 def _parameters_in_source(source, function):
-    """The parameter names of ``def function(...)`` in a module's source, or None."""
+    """The parameter names of ``def function(...)`` in a module's source, or None.
+
+    The last top-level definition is the one the module binds. None too for a
+    ``*args`` or ``**kwargs``: what such a function accepts is not in its names.
+    """
     try:
         tree = ast.parse(source)
     except SyntaxError:
         return None
-    for node in tree.body:
-        if isinstance(node, ast.FunctionDef) and node.name == function:
-            arguments = node.args
-            return [a.arg for a in arguments.posonlyargs + arguments.args + arguments.kwonlyargs]
-    return None
+    defined = [node for node in tree.body if isinstance(node, ast.FunctionDef) and node.name == function]
+    if not defined:
+        return None
+    arguments = defined[-1].args
+    if arguments.vararg or arguments.kwarg:
+        return None
+    return [a.arg for a in arguments.posonlyargs + arguments.args + arguments.kwonlyargs]
 
 
 # -- the generic findings ---------------------------------------------------------------
@@ -180,6 +187,17 @@ _IMPORT_FIXES = {
 }
 
 
+def _import_hint(name, module):
+    """What to add to a NameError of ``name`` in ``module``: the import that defines it, unless the
+    forbidden scan (with the module's own list) would refuse that import there."""
+    line = _IMPORT_FIXES.get(name)
+    if line is None:
+        return ""
+    if scan_source(line, extra=config.FORBIDDEN_IN_MODULE.get(module, ())):
+        return f": {module}.py may not import `{name}` (forbidden there): write that code yourself, no library's"
+    return f": add `{line}` at the top of {module}.py"
+
+
 def _same_error_everywhere(function, calls, outcomes, failed, context):
     if len(calls) < 2 or not all(c.raised for c in calls):
         return None
@@ -193,8 +211,7 @@ def _same_error_everywhere(function, calls, outcomes, failed, context):
     message = f"every call raised {error_type}{shown}{place}"
     if error_type == "NameError" and shown:
         name = shown.split("'")[1] if shown.count("'") >= 2 else ""
-        if name in _IMPORT_FIXES:
-            message += f": add `{_IMPORT_FIXES[name]}` at the top of {GRADED_FUNCTIONS[function]}.py"
+        message += _import_hint(name, GRADED_FUNCTIONS[function])
     explained = tuple(t for t in failed if any(c.test == t for c in calls))
     return Diagnosis("same_error_everywhere", message, explained)
 
@@ -338,9 +355,19 @@ def _one_rule(function, calls, outcomes, failed, context):
 def same(a, b, rtol=1e-6, atol=1e-8):
     """Whether two answers are equal: arrays (NaN equal to NaN), numbers, tuples, dicts."""
     if isinstance(a, tuple) or isinstance(b, tuple):
-        return isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b) and all(map(same, a, b))
+        return (
+            isinstance(a, tuple)
+            and isinstance(b, tuple)
+            and len(a) == len(b)
+            and all(same(x, y, rtol, atol) for x, y in zip(a, b))
+        )
     if isinstance(a, dict) or isinstance(b, dict):
-        return isinstance(a, dict) and isinstance(b, dict) and set(a) == set(b) and all(same(a[k], b[k]) for k in a)
+        return (
+            isinstance(a, dict)
+            and isinstance(b, dict)
+            and set(a) == set(b)
+            and all(same(a[k], b[k], rtol, atol) for k in a)
+        )
     try:
         a, b = np.asarray(a), np.asarray(b)
     except Exception:
