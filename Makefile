@@ -1,4 +1,4 @@
-# 3D Point Cloud Processing, Lecture 1: set-up, book, tests and grading.
+# 3D Point Cloud Processing: set-up, book, tests and grading.
 #   make book     set up, then build the book into _build/html
 #   make test     set up, lint, build the book, run the whole test suite
 #   make test-images  build Gradescope's image and the README's set-up on Ubuntu 22.04

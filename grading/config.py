@@ -45,6 +45,14 @@ ASSIGNMENTS = {
 GRADED_FUNCTIONS = {function: module for graded in ASSIGNMENTS.values() for function, module in graded.items()}
 EXERCISE_MODULES = tuple(dict.fromkeys(GRADED_FUNCTIONS.values()))  # pcl_course/<module>.py
 ASSIGNMENT_MODULES = {name: tuple(dict.fromkeys(graded.values())) for name, graded in ASSIGNMENTS.items()}
+# The course's title and its lectures' short titles (their parts of the book,
+# _toc.yml), one per assignment, in order. The book (_config.yml's title, the
+# part captions), pcl_course/__init__.py's docstring (its exercise modules by
+# lecture), pyproject.toml's description, the Makefile's first line and the
+# release's README (grading/templates/README.md's title) must agree with them:
+# tests/project/test_labels.py checks they do.
+COURSE_TITLE = "3D Point Cloud Processing"
+LECTURES = {"lecture1": "PCA, normals, downsampling and filters", "lecture2": "Nearest neighbours"}
 # Complete helper modules of pcl_course: they may use Open3D (data sets) and
 # are not exercises. A submission's copy is trusted only if it is unchanged.
 HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")

@@ -1,7 +1,10 @@
-"""3D Point Cloud Processing, Lecture 1: the student package.
+"""3D Point Cloud Processing: the student package.
 
-Exercise modules (implement the stubs): :mod:`pca`, :mod:`normals`,
-:mod:`downsampling`, :mod:`filters`, :mod:`metrics`.
+Exercise modules (implement the stubs), by lecture:
+
+- lecture 1, PCA, normals, downsampling and filters: :mod:`pca`,
+  :mod:`normals`, :mod:`downsampling`, :mod:`filters`, :mod:`metrics`;
+- lecture 2, nearest neighbours: :mod:`nn`.
 
 Complete helpers (use them): :mod:`validation`, :mod:`datasets`, :mod:`io`,
 :mod:`neighbors`, :mod:`plotting`, :mod:`book`.
