@@ -49,7 +49,7 @@ from grading.diagnosis import (
     same,
 )
 from grading.forbidden import scan_source
-from grading.mistakes import Mistake, Model
+from grading.instructors.mistakes import Mistake, Model
 
 FUNCTION = "pca"
 

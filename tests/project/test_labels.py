@@ -66,8 +66,8 @@ def test_pyproject_describes_the_course():
     assert _names_the_whole_course(description) is None
 
 
-# The course repository's Makefile and the student repository's (the release copies grading/templates/).
-@pytest.mark.parametrize("path", ["Makefile", "grading/templates/Makefile"])
+# The course repository's Makefile and the student repository's (the release copies grading/instructors/templates/).
+@pytest.mark.parametrize("path", ["Makefile", "grading/instructors/templates/Makefile"])
 def test_the_makefiles_header_names_the_course(path):
     header = _first_line(path)
     assert header.startswith("# "), header
@@ -75,7 +75,7 @@ def test_the_makefiles_header_names_the_course(path):
 
 
 def test_the_release_readme_is_titled_by_the_course():
-    title = _first_line("grading/templates/README.md")
+    title = _first_line("grading/instructors/templates/README.md")
     assert title.startswith("# "), title
     assert _names_the_whole_course(title.removeprefix("# ")) is None
 
