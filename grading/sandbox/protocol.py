@@ -206,7 +206,10 @@ def read_arrays(read_exactly, declared, limit, max_arrays):
         nbytes = dtype.itemsize * int(np.prod(shape, dtype=object))
         if _frame_size(read_exactly, nbytes) != nbytes:
             raise ProtocolError()
-        arrays.append(np.frombuffer(read_exactly(nbytes), dtype=dtype).reshape(shape))
+        try:
+            arrays.append(np.frombuffer(read_exactly(nbytes), dtype=dtype).reshape(shape))
+        except ValueError:  # extents NumPy cannot hold (an empty array of 2**62 x 2**62): never the submission's
+            raise ProtocolError() from None
     return arrays
 
 

@@ -413,3 +413,16 @@ def test_a_grader_without_a_dedicated_uid_leaves_room_for_its_own_processes():
     _, hard = resource.getrlimit(resource.RLIMIT_NPROC)
     expected = running + config.PROCESS_LIMIT
     assert process_limit(None) >= (expected if hard == resource.RLIM_INFINITY else min(expected, hard))
+
+
+def test_an_array_of_extents_numpy_cannot_hold_is_a_garbled_answer_not_a_value_error():
+    """Zero bytes declared as (0, 2**62 - 1, 2**62 - 1): the grader's own reshape fails, which must never
+    reach a test as a ValueError the submission seemed to raise (``raises(ValueError)`` would pass)."""
+    from grading.sandbox import protocol
+
+    frames = iter([protocol.MAGIC + (0).to_bytes(8, "little"), b""])
+    with pytest.raises(protocol.ProtocolError) as refused:
+        protocol.read_arrays(
+            lambda size: bytearray(next(frames)), [{"dtype": "<f8", "shape": [0, 2**62 - 1, 2**62 - 1]}], 1024, 8
+        )
+    assert refused.value.kind == protocol.GARBLED
