@@ -19,7 +19,7 @@ import numpy as np
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
 from grading.diagnosis import Call, contract_signature, size_of, snapshot
 from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
-from grading.forbidden import scan_package
+from grading.forbidden import read_source, scan_package
 
 _counter = itertools.count()
 
@@ -254,8 +254,8 @@ class Implementation:
         else:  # trusted code (the reference, the project's mutants)
             path = self.overrides.get(module, self.directory / f"{module}.py")
         try:
-            return Path(path).read_text(encoding="utf-8", errors="replace")
-        except OSError:
+            return read_source(path)
+        except (OSError, SyntaxError):
             return None
 
     def close(self):

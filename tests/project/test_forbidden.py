@@ -74,3 +74,24 @@ def test_a_forbidden_import_costs_the_whole_module_with_a_clear_message(tmp_path
     assert hidden and all(t["score"] == 0 and "sklearn" not in t["text"] for t in hidden)
     assert "metrics.py:1: from sklearn.metrics import ..." in chamfer[0]["text"]
     assert "Traceback" not in stdout
+
+
+@pytest.mark.parametrize("codec", ["utf-7", "utf-16"])
+def test_a_coding_line_cannot_hide_an_import_from_the_scan(tmp_path, codec):
+    """Python decodes a source by its PEP 263 coding line; so does the scan. In UTF-7, the
+    encoded newline ``+AAo-`` ends a comment for Python, not for a scan that reads UTF-8."""
+    package = tmp_path / "pcl_course"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    if codec == "utf-7":
+        data = b"# -*- coding: utf-7 -*-\n# a comment +AAo-from scipy.spatial import cKDTree\n"
+        assert "\nfrom scipy.spatial" in data.decode("utf-7")  # what Python runs
+    else:
+        # UTF-16 has no coding line Python accepts: the import fails, and the scan must say so.
+        hidden = "# a comment\nfrom scipy.spatial import cKDTree\n"
+        data = b"\xff\xfe" + hidden.encode("utf-16-le")
+    (package / "nn.py").write_bytes(data)
+    violations = scan_package(package, REPO_ROOT / "pcl_course")["nn"]
+    assert violations, f"{codec}: the scan saw nothing"
+    if codec == "utf-7":
+        assert any("scipy.spatial" in v.what for v in violations), violations
