@@ -75,13 +75,21 @@ def _installed_paths(dist_info):
     return {path for path in paths if path and not path.startswith("..")}
 
 
-def _masked_entries(site):
+def _masked_entries(site, extra=()):
     """Entries of a site folder the submission must not see: the forbidden
     packages (their modules, compiled libraries, bundled ``.libs`` and
-    metadata) and the editable install's files, which point back into the
-    course repository."""
-    forbidden = set(config.FORBIDDEN_PACKAGES)
-    masked = set()
+    metadata), the editable install's files, which point back into the
+    course repository, and the dotted names of ``extra`` (one exercise
+    module's, :data:`grading.config.FORBIDDEN_IN_MODULE`: ``scipy.spatial``
+    is the folder ``scipy/spatial``)."""
+    forbidden = set(config.FORBIDDEN_PACKAGES) | {name for name in extra if "." not in name}
+    masked = {
+        path
+        for name in extra
+        if "." in name and not name.startswith("pcl_course.")
+        for path in (site.joinpath(*name.split(".")), site.joinpath(*name.split(".")).with_suffix(".py"))
+        if path.exists()
+    }
     for entry in site.iterdir():
         stem = entry.name.split(".")[0].split("-")[0]
         if entry.name.startswith(("pcl_course", "pcl-course")) and entry.name.endswith(".dist-info"):
@@ -111,22 +119,29 @@ def _import_roots():
 
 
 @cache
-def masked_paths():
+def masked_paths(extra=()):
     """Every entry, in every folder the sandbox could import from, that a submission must not
-    reach: the forbidden packages and the editable install's files (:func:`_masked_entries`)."""
+    reach: the forbidden packages and the editable install's files, and the dotted names of
+    ``extra`` (a tuple: one exercise module's own, :func:`_masked_entries`)."""
     found = []
     for root, _ in _import_roots():
         for site_dir in _site_dirs(root):
-            found += [entry for entry in _masked_entries(site_dir) if entry not in found]
+            found += [entry for entry in _masked_entries(site_dir, extra) if entry not in found]
     return tuple(found)
 
 
+def sandbox_roots():
+    """(host folder, sandbox folder) of every folder bound into the sandbox that holds code."""
+    return _import_roots()
+
+
 @cache
-def _environment_binds():
+def _environment_binds(extra=()):
     """The options that bind the interpreter, the system libraries and the
-    site-packages, with every forbidden package masked: the same for every
-    worker of this process, and slow to find (every distribution's metadata
-    is read), so found once."""
+    site-packages, with every forbidden package masked (and ``extra``, one
+    exercise module's own): the same for every worker of this process with
+    the same ``extra``, and slow to find (every distribution's metadata is
+    read), so found once."""
     options = []
     for source in _system_roots():
         options += ["--ro-bind", source, source, "--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
@@ -135,7 +150,7 @@ def _environment_binds():
     for source, target in roots[len(_system_roots()) :]:
         options += ["--ro-bind", str(source), target]
     # Mask the forbidden packages wherever the sandbox could import them from.
-    for entry in masked_paths():
+    for entry in masked_paths(extra):
         source_root, target_root = next((s, t) for s, t in roots if s in entry.parents)
         target = f"{target_root}/{entry.relative_to(source_root)}"
         if entry.is_dir() and not entry.is_symlink():
@@ -145,8 +160,10 @@ def _environment_binds():
     return tuple(options)
 
 
-def bubblewrap_command(staged_root, python_argv_tail):
-    """The ``bwrap`` command line that runs the worker on a staged submission."""
+def bubblewrap_command(staged_root, python_argv_tail, extra=()):
+    """The ``bwrap`` command line that runs the worker on a staged submission, with the
+    forbidden packages masked, and ``extra`` too (a tuple of dotted names: one exercise
+    module's own, :data:`grading.config.FORBIDDEN_IN_MODULE`)."""
     executable, relative = python_executable()
     command = [
         "bwrap",
@@ -160,7 +177,7 @@ def bubblewrap_command(staged_root, python_argv_tail):
         "sandbox",
         "--cap-drop",
         "ALL",
-        *_environment_binds(),
+        *_environment_binds(tuple(extra)),
     ]
     command += [
         "--ro-bind",

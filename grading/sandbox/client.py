@@ -29,8 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from grading import config
-from grading.errors import SandboxError
-from grading.sandbox import protocol
+from grading.errors import ForbiddenAPI, SandboxError
+from grading.sandbox import mappings, protocol
 from grading.sandbox.bubblewrap import (
     WORKER_FILES,
     bubblewrap_command,
@@ -72,6 +72,7 @@ class Worker:
         self.broken = {}  # module -> why it cannot be imported
         self.last_modified = []
         self.known_pids = None  # the worker's processes at the last count (None: not counted yet)
+        self.extra = ()  # the running worker's own forbidden names (its module's, FORBIDDEN_IN_MODULE)
         if self.uid is not None:
             remove_files_of(self.uid)  # what an earlier grader, killed, may have left
 
@@ -84,9 +85,9 @@ class Worker:
             network = "namespace"
         else:
             network = "required" if self.uid is not None else "optional"
-        tail = [",".join(config.FORBIDDEN_PACKAGES), network]
+        tail = [",".join((*config.FORBIDDEN_PACKAGES, *self.extra)), network]
         if self.isolation.level == BUBBLEWRAP:
-            return bubblewrap_command(self.staged_root, tail), {}
+            return bubblewrap_command(self.staged_root, tail, self.extra), {}
         python = [
             str(python_executable()[0]),
             "-I",
@@ -210,8 +211,12 @@ class Worker:
         self.last_modified = []
         if module in self.broken:
             raise SandboxError(self.broken[module], kind=IMPORT)
+        extra = tuple(config.FORBIDDEN_IN_MODULE.get(module, ()))
+        if self.process is not None and self.extra != extra:
+            self.stop()  # a module with rules of its own runs in a worker of its own
         if self.process is None or self.process.poll() is not None:
             self.stop()
+            self.extra = extra
             self.start()
         try:
             result = self._call(module, function, args, kwargs)
@@ -222,11 +227,23 @@ class Worker:
                 self.stop()  # a timed-out, broken or forking worker never serves another call
             if from_submission and stray:
                 raise SandboxError(STRAY_MESSAGE, kind=STRAY) from None
+            self._refuse_forbidden_mappings(module)
             raise
         if self._stray_tasks():
             self.stop()
             raise SandboxError(STRAY_MESSAGE, kind=STRAY)
+        self._refuse_forbidden_mappings(module)
         return result
+
+    def _refuse_forbidden_mappings(self, module):
+        """Raise :class:`ForbiddenAPI` if the worker holds a library ``module`` may not use
+        (:mod:`grading.sandbox.mappings`), after stopping it: the next call starts clean."""
+        if self.process is None:
+            return
+        found = mappings.violation(self.known_pids or self._pids(), self.extra, self.isolation.level == BUBBLEWRAP)
+        if found is not None:
+            self.stop()
+            raise ForbiddenAPI(module, [f"{found} was loaded while {module}.py ran"])
 
     def _stray_tasks(self):
         """Whether the worker runs more threads or processes than when it started.

@@ -1,0 +1,175 @@
+"""The rules a submission must follow, enforced where it runs, not only where it is read.
+
+* forbidden libraries: whatever the spelling of the import (a computed
+  name, a finder removed from ``sys.meta_path``, a copy of the package in
+  another folder), a call that holds one fails; a module's own rules
+  (``scipy.spatial`` in ``nn.py``) bind that module only;
+* native code from outside the environment (a library the submission wrote
+  to disk) fails its call.
+
+Each test runs in both isolation levels a mark may come from: the strongest
+the machine allows (bubblewrap) and a dedicated uid without namespaces
+(Gradescope's container).
+"""
+
+import os
+import shutil
+import sysconfig
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _helpers import run_grader
+
+from grading import REPO_ROOT
+from grading.errors import ForbiddenAPI
+from grading.sandbox import UID, Isolation, Worker, reserve_uid
+from grading.staging import stage
+
+LEVELS = [
+    pytest.param("strongest", id="strongest"),
+    pytest.param("uid", id="uid", marks=pytest.mark.skipif(os.geteuid() != 0, reason="the uid mode needs root")),
+]
+
+NN = '''
+import importlib
+import sys
+
+
+def computed(points):
+    """scipy.spatial by a computed name, with the worker's own import finder removed first."""
+    sys.meta_path[:] = [f for f in sys.meta_path if "Forbidden" not in type(f).__name__]
+    spatial = importlib.import_module("scipy." + "spa" + "tial")
+    return spatial.cKDTree(points).query(points[:1], k=2)[1]
+
+
+def copied(points, folder):
+    """scikit-learn from a copy in another folder, the worker's import finder removed first."""
+    sys.meta_path[:] = [f for f in sys.meta_path if "Forbidden" not in type(f).__name__]
+    sys.path.insert(0, folder)
+    from sklearn.neighbors import KDTree
+
+    return KDTree(points).query(points[:1], k=2)[1]
+
+
+def written(points):
+    """A native library written to disk by the submission and loaded."""
+    import ctypes
+    import glob
+    import tempfile
+
+    library = sorted(glob.glob("/usr/lib/*/libz.so*") + glob.glob("/lib*/libz.so*"))[-1]
+    copy = tempfile.mkdtemp() + "/mine.so"
+    shutil.copy(library, copy)
+    ctypes.CDLL(copy)
+    return points.sum()
+
+
+def plain(points):
+    return points.sum()
+
+
+import shutil  # noqa: E402
+'''
+
+PCA = '''
+from scipy.spatial import cKDTree
+
+
+def allowed(points):
+    """Lecture 1 may use scipy.spatial."""
+    return cKDTree(points).query(points[:1], k=2)[1]
+'''
+
+
+def worker(tmp_path, level, timeout=20):
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "nn.py").write_text(textwrap.dedent(NN))
+    (package / "pca.py").write_text(textwrap.dedent(PCA))
+    isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
+    return Worker(stage(package).root, timeout=timeout, level=isolated)
+
+
+POINTS = np.random.default_rng(3).random((40, 3))
+NEAREST_TWO = [0, int(np.argsort(((POINTS - POINTS[0]) ** 2).sum(axis=1))[1])]
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_a_library_forbidden_in_one_module_fails_there_however_imported(tmp_path, level):
+    impl = worker(tmp_path, level)
+    try:
+        assert impl.call("nn", "plain", (POINTS,), {}) == pytest.approx(POINTS.sum())
+        assert list(impl.call("pca", "allowed", (POINTS,), {})[0]) == NEAREST_TWO  # lecture 1: allowed
+        # Masked under bubblewrap (the import finds nothing), a verdict as a uid: either way no answer.
+        with pytest.raises((ForbiddenAPI, AttributeError, ImportError)) as failure:
+            impl.call("nn", "computed", (POINTS,), {})
+        if level == "uid":
+            assert failure.type is ForbiddenAPI and "scipy.spatial was loaded while nn.py ran" in str(failure.value)
+        # The next call starts clean, and the other module's rules are its own again.
+        assert impl.call("nn", "plain", (POINTS,), {}) == pytest.approx(POINTS.sum())
+        assert list(impl.call("pca", "allowed", (POINTS,), {})[0]) == NEAREST_TWO
+    finally:
+        impl.close()
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_a_copy_of_a_forbidden_package_in_another_folder_fails(tmp_path, level):
+    site = Path(sysconfig.get_paths()["purelib"])
+    copy = tmp_path / "elsewhere"
+    copy.mkdir()
+    for entry in site.iterdir():
+        if entry.name == "sklearn" or entry.name.startswith("scikit_learn"):
+            shutil.copytree(entry, copy / entry.name, ignore=shutil.ignore_patterns("tests", "__pycache__"))
+    for folder in [copy, *copy.parents]:  # reachable by the sandbox uid: the copy is not the grader's
+        if folder == Path("/"):
+            break
+        folder.chmod(folder.stat().st_mode | 0o755)
+    os.system(f"chmod -R a+rX {copy}")
+    impl = worker(tmp_path, level)
+    try:
+        with pytest.raises((ForbiddenAPI, ImportError)) as failure:
+            impl.call("nn", "copied", (POINTS, str(copy)), {})
+        if level == "uid":
+            assert failure.type is ForbiddenAPI, failure.value
+    finally:
+        impl.close()
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_native_code_the_submission_wrote_fails_its_call(tmp_path, level):
+    impl = worker(tmp_path, level)
+    try:
+        with pytest.raises(ForbiddenAPI, match="native code from outside the environment"):
+            impl.call("nn", "written", (POINTS,), {})
+        assert impl.call("nn", "plain", (POINTS,), {}) == pytest.approx(POINTS.sum())
+    finally:
+        impl.close()
+
+
+def test_a_search_built_on_a_hidden_import_scores_nothing(tmp_path):
+    """The whole grader: a kdtree_knn on cKDTree, reached by an attribute the scan cannot read,
+    scores nothing (bubblewrap: the package is masked; uid: the verdict names it)."""
+    package = tmp_path / "clone" / "pcl_course"
+    shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
+    (package / "nn.py").write_text(
+        (package / "nn.py").read_text()  # the stubs, then a kdtree_knn of the student's
+        + textwrap.dedent(
+            """
+
+            def kdtree_knn(tree, points, queries, k):
+                import scipy
+
+                spatial = getattr(scipy, "spatial")  # SciPy imports its submodules on first access
+                distances, indices = spatial.cKDTree(points).query(queries, k=k)
+                return indices.reshape(len(queries), k), distances.reshape(len(queries), k)
+            """
+        )
+    )
+    results, _ = run_grader(str(tmp_path / "clone"), "--assignment", "lecture2", "-k", "kdtree_knn", tmp_path=tmp_path)
+    scored = [t for t in results["tests"] if "kdtree_knn" in t["name"]]
+    assert any("cannot be imported" not in t["text"] for t in scored)
+    assert scored and sum(t["score"] for t in scored) == 0, [(t["name"], t["score"]) for t in scored]
+    assert all("Traceback" not in t["text"] for t in scored)
