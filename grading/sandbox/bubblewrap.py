@@ -223,7 +223,8 @@ def spawn(command, **kwargs):
     finally:
         os.close(write)
     try:
-        return subprocess.Popen(["bwrap", "--args", str(read), *command[end:]], pass_fds=(read,), **kwargs)
+        passed = (read, *kwargs.pop("pass_fds", ()))
+        return subprocess.Popen(["bwrap", "--args", str(read), *command[end:]], pass_fds=passed, **kwargs)
     finally:
         os.close(read)
 

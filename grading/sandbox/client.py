@@ -73,6 +73,7 @@ class Worker:
         self.last_modified = []
         self.known_pids = None  # the worker's processes at the last count (None: not counted yet)
         self.extra = ()  # the running worker's own forbidden names (its module's, FORBIDDEN_IN_MODULE)
+        self.exchange = None  # the memfd that holds a call's array arguments, shared with the worker
         if self.uid is not None:
             remove_files_of(self.uid)  # what an earlier grader, killed, may have left
 
@@ -85,7 +86,7 @@ class Worker:
             network = "namespace"
         else:
             network = "required" if self.uid is not None else "optional"
-        tail = [",".join((*config.FORBIDDEN_PACKAGES, *self.extra)), network]
+        tail = [",".join((*config.FORBIDDEN_PACKAGES, *self.extra)), network, str(self.exchange)]
         if self.isolation.level == BUBBLEWRAP:
             return bubblewrap_command(self.staged_root, tail, self.extra), {}
         python = [
@@ -112,6 +113,7 @@ class Worker:
         self.work = tempfile.mkdtemp(prefix="grading-home-")  # HOME of the uid and none levels
         if self.uid is not None:
             os.chown(self.work, self.uid, self.uid)
+        self.exchange = os.memfd_create("pcl-call-arguments")
         command, env = self._command()
         self.known_pids = None  # a restarted worker's processes are new
         self.stderr = tempfile.TemporaryFile()
@@ -123,6 +125,7 @@ class Worker:
             env=env,
             cwd=self.work,
             preexec_fn=preexec(self.uid),
+            pass_fds=(self.exchange,),
         )
         try:
             header = self._read_header(_Deadline(self, max(self.timeout, 60.0)))
@@ -152,6 +155,9 @@ class Worker:
         if self.work:
             shutil.rmtree(self.work, ignore_errors=True)
             self.work = None
+        if self.exchange is not None:
+            os.close(self.exchange)
+            self.exchange = None
 
     def close(self):
         """Stop the worker and remove every file its uid left anywhere writable."""
@@ -201,12 +207,14 @@ class Worker:
     def call(self, module, function, args, kwargs):
         """Call ``pcl_course.<module>.<function>(*args, **kwargs)`` in the worker.
 
-        The arguments here are never changed: the worker works on its own
-        copies. Returns the answer; :attr:`last_modified` then holds the
-        paths of the arguments the call modified in place (``["args", 0]``
-        is the first positional one, ``["kwargs", "name"]`` a keyword one).
-        A random generator among the arguments draws on from where the call
-        left it.
+        The arguments here are never changed: the function works on copies
+        in memory the grader shares with the worker (a memfd), which the
+        grader reads back itself. Returns the answer; :attr:`last_modified`
+        then holds the paths of the arguments the call modified in place
+        (``["args", 0]`` is the first positional one, ``["kwargs", "name"]``
+        a keyword one), arrays by the grader's own reading, random
+        generators by the state they came back in. A random generator among
+        the arguments draws on from where the call left it.
         """
         self.last_modified = []
         if module in self.broken:
@@ -265,7 +273,18 @@ class Worker:
     def _call(self, module, function, args, kwargs):
         arguments = {"args": list(args), "kwargs": dict(kwargs)}
         read_only = [path for path, value in _arrays(arguments, []) if not value.flags.writeable]
-        request = {"module": module, "function": function, "args": args, "kwargs": kwargs, "read_only": read_only}
+        shared, size = _layout(arguments)
+        os.ftruncate(self.exchange, 0)  # nothing of an earlier call's
+        os.ftruncate(self.exchange, size)
+        request = {
+            "module": module,
+            "function": function,
+            "args": args,
+            "kwargs": kwargs,
+            "read_only": read_only,
+            "exchange": [(path, offset) for path, _, offset in shared],
+            "exchange_size": size,
+        }
         deadline = _Deadline(self, self.timeout)
         try:
             protocol.write_request(self.process.stdin, request)
@@ -292,7 +311,7 @@ class Worker:
             raise SandboxError(self.broken[module], kind=IMPORT)
         answer = self._read_header(deadline)
         arrays = self._read_arrays(answer.get("arrays", []), deadline)
-        self.last_modified = _modified_paths(arguments, answer.get("modified", []))
+        self.last_modified = _modified_paths(arguments, answer.get("modified", [])) + self._changed_in_place(shared)
         if answer.get("ok") is not True:
             if not isinstance(answer.get("type"), str):
                 raise SandboxError("the worker's answer was garbled", kind=GARBLED)
@@ -301,6 +320,20 @@ class Worker:
             exc.modified = self.last_modified
             raise exc
         return _unwrapped(protocol.decode, answer.get("value"), arrays)
+
+    def _changed_in_place(self, shared):
+        """The paths of the array arguments whose copy in the shared memory the call changed:
+        read here, from memory the grader made, not from what the worker says."""
+        changed = []
+        for path, value, offset in shared:
+            data = os.pread(self.exchange, value.nbytes, offset)
+            if len(data) != value.nbytes:  # the file was cut short: the memory was changed
+                changed.append(path)
+                continue
+            after = np.frombuffer(data, dtype=value.dtype).reshape(value.shape)
+            if not np.array_equal(after, value, equal_nan=value.dtype.kind in "fc"):
+                changed.append(path)
+        return changed
 
     # -- reading the worker's frames, every size checked before it is read ---------
 
@@ -405,9 +438,22 @@ def _arrays(value, path):
             yield from _arrays(item, [*path, key])
 
 
+def _layout(arguments):
+    """Where each array argument goes in the shared memory: ([(path, array, offset)], size)."""
+    shared, size = [], 0
+    for path, value in _arrays(arguments, []):
+        if value.dtype.hasobject:
+            continue
+        size = -(-size // 64) * 64  # each array on its own cache line, aligned for any dtype
+        shared.append((path, value, size))
+        size += value.nbytes
+    return shared, size
+
+
 def _modified_paths(arguments, modified):
-    """The paths of the arguments the call modified, as the worker names them; a random
-    generator takes the new state the worker sent (checked: one its own stream reaches)."""
+    """The paths of the random generators the call drew from, as the worker names them, each
+    given the new state the worker sent (checked: one its own stream reaches). Arrays are not
+    the worker's to report (:meth:`Worker._changed_in_place`)."""
     if not isinstance(modified, list) or len(modified) > config.MAX_ARRAYS:
         raise SandboxError("the worker's answer was garbled", kind=GARBLED)
     paths = []
@@ -418,10 +464,9 @@ def _modified_paths(arguments, modified):
                 target = target[step]
         except (KeyError, IndexError, TypeError):
             raise SandboxError("the worker's answer was garbled", kind=GARBLED) from None
-        if isinstance(target, np.random.Generator):
-            set_generator_state(target, change.get("state"))
-        elif type(target) is not np.ndarray:
+        if not isinstance(target, np.random.Generator):
             raise SandboxError("the worker's answer was garbled", kind=GARBLED)
+        set_generator_state(target, change.get("state"))
         paths.append(list(change["path"]))
     return paths
 

@@ -10,10 +10,12 @@ the original stdout. Whatever the submission prints goes to stderr.
 Each call is answered in two steps, so that the grader can tell a module
 that cannot be imported from a function that fails: first
 ``{"imported": true}`` (or the import's failure), then the call's answer.
-The answer also names every argument the call modified in place (its path,
-no value): the grader's own arguments stay as they were before the call,
-and the modification is a verdict of its own. A random generator's new
-state is sent back, so that a later call draws on from it.
+Every array argument lives, for the call, in memory the grader shares
+(``EXCHANGE_FD``, a memfd the grader made): the worker copies it there and
+hands the function that copy, so a change the function makes in place is
+seen by the grader itself, not reported by this process, which the
+submission could rewrite. A random generator's new state is sent back, so
+that a later call draws on from it.
 
 Outside bubblewrap, before it imports anything of the submission's, the
 worker closes the network with a seccomp filter (:func:`close_network`):
@@ -22,8 +24,8 @@ dedicated uid without namespaces (a Docker container) the filter is the
 wall, and the worker refuses to run without it; under bubblewrap the empty
 network namespace is.
 
-Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES NETWORK
-(FORBIDDEN_PACKAGES comma-separated, from grading.config; NETWORK is
+Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES NETWORK EXCHANGE_FD
+(FORBIDDEN_PACKAGES comma-separated dotted names, from grading.config; NETWORK is
 ``required`` or ``optional``: whether the worker may run when the filter
 cannot be installed, or ``namespace``: no filter, bubblewrap's network
 namespace is the wall), or python -I -S worker.py --check-network SITE_PACKAGES.
@@ -93,34 +95,48 @@ def _check_network(site_packages):
     print(json.dumps({"closed": why_not is None, "why": why_not}))
 
 
-def _mutable_arguments(value, path, np):
-    """(path, object) of every array and random generator inside the arguments."""
-    if type(value) is np.ndarray:
-        yield path, value
-    elif isinstance(value, np.random.Generator):
+def _generators(value, path, np):
+    """(path, generator) of every random generator inside the arguments."""
+    if isinstance(value, np.random.Generator):
         yield path, value
     elif type(value) in (tuple, list):
         for i, item in enumerate(value):
-            yield from _mutable_arguments(item, [*path, i], np)
+            yield from _generators(item, [*path, i], np)
     elif type(value) is dict:
         for key, item in value.items():
-            yield from _mutable_arguments(item, [*path, key], np)
+            yield from _generators(item, [*path, key], np)
 
 
-def _snapshot(value, np):
-    if isinstance(value, np.random.Generator):
-        return value.bit_generator.state
-    return value.copy()
+def _substituted(value, path, new):
+    """``value`` with the item at ``path`` replaced by ``new`` (tuples rebuilt, lists and dicts
+    changed in place)."""
+    if not path:
+        return new
+    head, rest = path[0], path[1:]
+    if type(value) is tuple:
+        return tuple(_substituted(item, rest, new) if i == head else item for i, item in enumerate(value))
+    value[head] = _substituted(value[head], rest, new)
+    return value
 
 
-def _changed(value, before, np):
-    if isinstance(value, np.random.Generator):
-        return value.bit_generator.state != before
-    return (
-        value.shape != before.shape
-        or value.dtype != before.dtype
-        or not np.array_equal(value, before, equal_nan=value.dtype.kind in "fc")
-    )
+def _shared(arguments, request, exchange, np):
+    """``arguments`` with every array the grader placed in the shared memory replaced by its
+    copy there (read-only flags kept): what the function changes, the grader sees."""
+    import mmap
+
+    size = request.get("exchange_size", 0)
+    if not size or exchange is None:
+        return arguments
+    memory = mmap.mmap(exchange, size)
+    for path, offset in request["exchange"]:
+        value = arguments
+        for step in path:
+            value = value[step]
+        copy = np.ndarray(value.shape, value.dtype, buffer=memory, offset=offset)
+        copy[...] = value
+        copy.flags.writeable = value.flags.writeable
+        arguments = _substituted(arguments, path, copy)
+    return arguments
 
 
 def _where(exc):
@@ -152,7 +168,7 @@ def _load_protocol():
     return module
 
 
-def _call(request, wire, sender, np):
+def _call(request, wire, sender, np, exchange=None):
     try:
         module = importlib.import_module(f"pcl_course.{request['module']}")
     except BaseException as exc:  # noqa: B902 -- SystemExit at import is an answer too
@@ -165,7 +181,8 @@ def _call(request, wire, sender, np):
         for step in path:
             array = array[step]
         array.flags.writeable = False
-    watched = [(path, value, _snapshot(value, np)) for path, value in _mutable_arguments(arguments, [], np)]
+    arguments = _shared(arguments, request, exchange, np)
+    watched = [(path, value, value.bit_generator.state) for path, value in _generators(arguments, [], np)]
     try:
         function = getattr(module, request["function"], None)
         if function is None:
@@ -177,12 +194,9 @@ def _call(request, wire, sender, np):
         arrays, answer = [], _failure(exc)
     modified = []
     for path, value, before in watched:
-        if _changed(value, before, np):
-            if isinstance(value, np.random.Generator):
-                modified.append({"path": path, "state": value.bit_generator.state})
-            else:
-                modified.append({"path": path})
-    answer["modified"] = modified
+        if value.bit_generator.state != before:
+            modified.append({"path": path, "state": value.bit_generator.state})
+    answer["modified"] = modified  # the generators; the grader reads the arrays it shared itself
     sender.send(answer, arrays)
 
 
@@ -190,6 +204,7 @@ def main():
     if sys.argv[1] == "--check-network":
         return _check_network(sys.argv[2])
     site_packages, submission, forbidden, network = sys.argv[1], sys.argv[2], sys.argv[3].split(","), sys.argv[4]
+    exchange = int(sys.argv[5]) if len(sys.argv) > 5 else None
     answers = os.fdopen(os.dup(1), "wb", buffering=0)
     os.dup2(2, 1)  # the submission's prints go to stderr, not into the protocol
     sys.stdout = sys.stderr
@@ -209,7 +224,7 @@ def main():
 
     sender.send({"ready": True})
     while (request := wire.read_request(requests)) is not None:
-        _call(request, wire, sender, np)
+        _call(request, wire, sender, np, exchange)
 
 
 if __name__ == "__main__":

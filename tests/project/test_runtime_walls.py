@@ -14,6 +14,7 @@ the machine allows (bubblewrap) and a dedicated uid without namespaces
 
 import os
 import shutil
+import subprocess
 import sysconfig
 import textwrap
 from pathlib import Path
@@ -127,7 +128,9 @@ def test_a_copy_of_a_forbidden_package_in_another_folder_fails(tmp_path, level):
         if folder == Path("/"):
             break
         folder.chmod(folder.stat().st_mode | 0o755)
-    os.system(f"chmod -R a+rX {copy}")
+    # Without the ACLs that bar the sandbox uids from the environment's own copy (copied with it).
+    subprocess.run(["setfacl", "-R", "-b", str(copy)], check=False, capture_output=True)
+    subprocess.run(["chmod", "-R", "a+rX", str(copy)], check=True)
     impl = worker(tmp_path, level)
     try:
         with pytest.raises((ForbiddenAPI, ImportError)) as failure:
@@ -173,3 +176,66 @@ def test_a_search_built_on_a_hidden_import_scores_nothing(tmp_path):
     assert any("cannot be imported" not in t["text"] for t in scored)
     assert scored and sum(t["score"] for t in scored) == 0, [(t["name"], t["score"]) for t in scored]
     assert all("Traceback" not in t["text"] for t in scored)
+
+
+# -- the in-place verdict ----------------------------------------------------------------------------
+
+TAMPERING_PCA = '''
+
+import sys as _sys
+
+
+def _silence_the_worker():
+    """Rewrite every record the worker process could keep of a changed argument."""
+    main = _sys.modules["__main__"]
+    for name in dir(main):
+        if name.startswith("_") and ("chang" in name or "mutable" in name or "snapshot" in name):
+            setattr(main, name, (lambda *args, **kwargs: False) if "chang" in name else (lambda *a, **k: iter(())))
+
+
+_reference_pca = pca
+
+
+def pca(points, correlation=False, sort=True):
+    _silence_the_worker()
+    answer = _reference_pca(np.array(points, dtype=float), correlation, sort)
+    if isinstance(points, np.ndarray) and points.dtype.kind == "f":
+        points.flags.writeable = True  # NumPy allows it when the memory is writable
+        points -= points.mean(axis=0)  # in place: the caller's array changes
+    return answer
+'''
+
+
+TAMPERED_REFERENCE = (REPO_ROOT / "solutions" / "pca.py").read_text() + TAMPERING_PCA
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_the_in_place_verdict_is_the_graders_whatever_the_worker_rewrites(tmp_path, level):
+    impl = worker(tmp_path, level)
+    staged = impl.staged_root / "pcl_course"
+    (staged / "pca.py").chmod(0o644)
+    (staged / "pca.py").write_text(TAMPERED_REFERENCE)
+    shutil.copy(REPO_ROOT / "pcl_course" / "validation.py", staged / "validation.py")
+    (staged / "validation.py").chmod(0o644)
+    points = np.random.default_rng(5).random((30, 3)) + 10.0
+    original = points.copy()
+    try:
+        for _ in range(2):  # the second call runs in a worker the first one rewrote
+            impl.call("pca", "pca", (points,), {})
+            assert impl.last_modified == [["args", 0]]
+            np.testing.assert_array_equal(points, original)  # the grader's own copy never changes
+        readonly = points.copy()
+        readonly.flags.writeable = False  # numpy's flag can be set back by the function: the verdict holds
+        impl.call("pca", "pca", (readonly,), {})
+        assert impl.last_modified == [["args", 0]]
+    finally:
+        impl.close()
+
+
+def test_a_pca_that_hides_its_in_place_change_loses_the_point(tmp_path):
+    package = tmp_path / "clone" / "pcl_course"
+    shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
+    (package / "pca.py").write_text(TAMPERED_REFERENCE)
+    results, _ = run_grader(str(tmp_path / "clone"), "-k", "test_pca_does_not_modify_its_input", tmp_path=tmp_path)
+    (test,) = [t for t in results["tests"] if t["name"].startswith("test_pca_does_not_modify_its_input")]
+    assert test["score"] == 0 and "modified its input in place" in test["text"], test["text"]
