@@ -335,6 +335,20 @@ def test_the_workflow_summary_says_why_grading_did_not_run(release_dir, tmp_path
     assert expected in (tmp_path / "summary.md").read_text()
 
 
+def test_the_students_grader_refuses_to_run_with_a_link_in_it(release_dir, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(release_dir, copy, ignore=PRISTINE_COPY)
+    (copy / "grading" / "instructors").symlink_to("../pcl_course")  # would pass for the instructors' grader
+    env = {**os.environ, "PYTHONPATH": str(copy)}
+    for command in (["-m", "grading", "grade", "."], ["-m", "pytest", "tests/graded", "-p", "no:cacheprovider"]):
+        completed = subprocess.run(
+            [sys.executable, *command], cwd=copy, capture_output=True, text=True, timeout=SUBPROCESS_BACKSTOP, env=env
+        )
+        assert completed.returncode != 0, command
+        assert "refusing to" in completed.stdout + completed.stderr, completed.stdout + completed.stderr
+        assert "grading/instructors is not a regular file or folder" in completed.stdout + completed.stderr
+
+
 def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
     completed = subprocess.run(
         [sys.executable, "-m", "grading", "grade", ".", "--results", "r.json"],
