@@ -176,7 +176,7 @@ SUMMARY = f"""\
          "PCL_COURSE_TOKEN; the release's commit must carry the tag $COURSE_REF."
   elif [ "$COMPARE" = failure ] || [ "$HASHES" = failure ]; then
     echo "Grading did not run: this repository's grader ({", ".join(GRADER_FILES)}) is not the" \\
-         "release's, or holds a link. Restore those files from the course repository:"
+         "release's, or holds a link. Restore those files as released (the course repository's):"
     echo
     echo '```'
     head -n 25 {CHECKED} 2> /dev/null || true
