@@ -36,6 +36,8 @@ mistakes and each lecture's own checkers (``trees.py``). A copy of the
 grader without that folder is a student's (:func:`instructors_grader`).
 """
 
+import os
+import stat
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
@@ -50,7 +52,31 @@ def instructors_grader():
     The one test of a student's copy: the release withholds
     ``grading/instructors/`` whole, and nothing else of the grader's.
     """
-    return INSTRUCTORS.is_dir()
+    return INSTRUCTORS.is_dir() and not INSTRUCTORS.is_symlink()
+
+
+def grader_links():
+    """The entries of this grader that are not regular files or folders, as printable lines.
+
+    ``grading/`` and the graded tests are read without following a link:
+    a symbolic link (or a FIFO, a device) there could make the grader run
+    other code, a submission's included, so the grader refuses to run while
+    one is there (the students' advisory check refuses it too).
+    """
+    found = []
+    for top in (REPO_ROOT / "grading", GRADED_TESTS, HIDDEN_TESTS):
+        entries = [str(top)] if os.path.lexists(top) else []
+        while entries:
+            path = entries.pop()
+            mode = os.lstat(path).st_mode
+            if stat.S_ISDIR(mode):
+                try:
+                    entries += [os.path.join(path, name) for name in os.listdir(path)]
+                except PermissionError:  # a folder this user cannot list, nor pytest collect
+                    continue
+            elif not stat.S_ISREG(mode):
+                found.append(f"{ascii(os.path.relpath(path, REPO_ROOT))[1:-1]} is not a regular file or folder")
+    return sorted(found)
 
 
 from grading.config import (  # noqa: E402,F401

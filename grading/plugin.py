@@ -22,14 +22,19 @@ from pathlib import Path
 
 import pytest
 
-from grading import GRADED_FUNCTIONS, diagnosis, instructors_grader
-from grading import config as grading_config
-from grading.diagnosis import Outcome
-from grading.errors import SandboxError, TestTimeout
-from grading.feedback import classify
-from grading.implementation import Implementation
-from grading.options import MARKERS, PLUGIN_ONLY, SHARED
-from grading.results import Grading, TestResult, clean
+from grading import grader_links
+
+if links := grader_links():  # before another module of the grader is imported
+    raise pytest.UsageError(f"refusing to grade: the grader holds a link or special file: {links[0]}")
+
+from grading import GRADED_FUNCTIONS, diagnosis, instructors_grader  # noqa: E402
+from grading import config as grading_config  # noqa: E402
+from grading.diagnosis import Outcome  # noqa: E402
+from grading.errors import SandboxError, TestTimeout  # noqa: E402
+from grading.feedback import classify  # noqa: E402
+from grading.implementation import Implementation  # noqa: E402
+from grading.options import MARKERS, PLUGIN_ONLY, SHARED  # noqa: E402
+from grading.results import Grading, TestResult, clean  # noqa: E402
 
 # The catalogue of known mistakes: the instructors' grader only (a student's copy has none).
 mistakes = importlib.import_module("grading.instructors.mistakes") if instructors_grader() else None

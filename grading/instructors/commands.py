@@ -54,6 +54,12 @@ def _release_arguments(parser):
         help="the published student repository whose grader the students' workflow checks out "
         "(default: the repository variable PCL_COURSE_REPOSITORY)",
     )
+    parser.add_argument(
+        "--course-ref",
+        metavar="REF",
+        help="the course repository's tag or commit of this release, which the workflow checks out "
+        "(default: grader-<the first 12 hex digits of the grader's digest>)",
+    )
 
 
 def _similarity_arguments(parser):
@@ -94,13 +100,19 @@ def _batch(args):
 
 
 def _release(args):
-    from grading.instructors.release import release
+    from grading.instructors.release import course_tag, grader_digest, release
 
-    leaks = release(args.out_dir, args.course_repository)
+    leaks = release(args.out_dir, args.course_repository, args.course_ref)
     if leaks:
         print("error: the release contains reference code:\n" + "\n".join(leaks[:20]), file=sys.stderr)
         return 1
+    digest = grader_digest(args.out_dir)
     print(f"Student repository written to {args.out_dir}")
+    print(f"The grader's digest (publish it: the students' check prints it): {digest}")
+    print(
+        f"Tag the commit of the course repository that holds this release {args.course_ref or course_tag(digest)}"
+        " (the students' workflow checks out that ref)"
+    )
     return 0
 
 

@@ -39,9 +39,15 @@ COPIED = [
 ]
 
 TEMPLATES = Path(__file__).with_name("templates")  # the student repository's own files
-# The files whose hashes the workflow checks before it trusts this repository's grader.
-GRADER_FILES = ("grading", "tests/graded", "pyproject.toml")
+WORKFLOW = ".github/workflows/check.yml"  # the students' advisory check
+CHECK_SCRIPT = ".github/check_grader.py"  # its test of the grader (templates/check_grader.py)
+PRISTINE = ".github/pristine/pcl_course"  # the released stubs: the grader's pcl_course when no course is named
+# Everything the workflow runs or reads as the grader: its code, public tests,
+# package set-up and pins, the check itself, and the stubs whose signatures it reads.
+GRADER_FILES = ("grading", "tests/graded", "pyproject.toml", "requirements/grading.txt", CHECK_SCRIPT, PRISTINE)
 GRADER_MANIFEST = ".github/grader.sha256"
+# What must be identical to the course repository's copy when one is named.
+COMPARED = (*GRADER_FILES, GRADER_MANIFEST, WORKFLOW)
 
 
 INSTRUCTOR_ONLY = "instructor-only"  # the class that keeps a {solution} out of the student release
@@ -86,10 +92,13 @@ WORKFLOW_HEADER = """\
 # table goes to the run's summary. The grader is either the course
 # repository's (COURSE_REPOSITORY below, or the repository variable
 # PCL_COURSE_REPOSITORY; a private one needs a read token in the secret
-# PCL_COURSE_TOKEN), or, when none is named, this repository's own copy,
-# used only if its files match the release's hashes (.github/grader.sha256).
-# You control this repository, so this mark is advisory: the official mark
-# is the instructor's (Gradescope, or their re-grade of your submission).
+# PCL_COURSE_TOKEN), checked out at the release's tag (COURSE_REF), to which
+# this repository's grader must be identical; or, when none is named, this
+# repository's own copy, used only if it matches the release's manifest
+# (.github/grader.sha256, whose digest is GRADER_DIGEST below). A link
+# anywhere in the grader refuses the check. You control this repository and
+# this workflow, so this mark is advisory: the official mark is the
+# instructor's (Gradescope, or their re-grade of your submission).
 """
 
 
@@ -103,26 +112,31 @@ _WorkflowDumper.add_representer(
 )
 
 ACTIONS = {"checkout": "actions/checkout@v6", "setup-python": "actions/setup-python@v6"}
+CHECKED = "grader-check.txt"  # the check's lines, for the summary (in the runner's workspace)
 
 CHOOSE_GRADER = """\
 if [ -n "$COURSE_REPOSITORY" ]; then
   echo "source=course" >> "$GITHUB_OUTPUT"
-  echo "Grading with the course repository $COURSE_REPOSITORY's grader"
+  echo "Grading with the course repository $COURSE_REPOSITORY's grader at $COURSE_REF"
 else
   echo "source=hashes" >> "$GITHUB_OUTPUT"
-  echo "No course repository named: grading with this repository's grader, if it matches the release's hashes"
+  echo "No course repository named: grading with this repository's grader, if it matches the release's manifest"
 fi"""
 
+COMPARE = f"""\
+# The course's own check script, on this repository's grader against the course's (list, kinds, bytes).
+set -o pipefail
+python3 -I course/{CHECK_SCRIPT} submission {" ".join(COMPARED)} --course course | tee {CHECKED}"""
+
 CHECK_HASHES = f"""\
-# Every grader file listed, no file added, every hash equal.
-find {" ".join(GRADER_FILES)} -type f ! -path '*/__pycache__/*' ! -name '*.pyc' | sort > /tmp/present
-awk '{{print $2}}' {GRADER_MANIFEST} | sort > /tmp/released
-if ! diff /tmp/released /tmp/present || ! sha256sum --check --strict --quiet {GRADER_MANIFEST}; then
-  echo "::error::this repository's grader (grading/, tests/graded/, pyproject.toml) differs from the release:" \\
-       "restore those files from the first commit, or name the course repository"
-  exit 1
-fi
-mkdir -p ../course && cp -a --parents {" ".join(GRADER_FILES)} pcl_course requirements scripts ../course/"""
+# This repository's grader against the release's manifest, whose digest the workflow records.
+set -o pipefail
+python3 -I submission/{CHECK_SCRIPT} submission {" ".join(GRADER_FILES)} \\
+  --manifest {GRADER_MANIFEST} --digest "$GRADER_DIGEST" | tee {CHECKED}
+# The grader as checked, and the released stubs as its pcl_course (never the submission's).
+mkdir course
+(cd submission && cp -a --parents {" ".join(name for name in GRADER_FILES if name != PRISTINE)} ../course/)
+cp -a submission/{PRISTINE} course/pcl_course"""
 
 SET_UP = """\
 sudo apt-get update -qq
@@ -138,39 +152,70 @@ set -o pipefail
 python -m grading grade ../submission --require-isolation --results ../results/results.json \\
   | tee ../results/marks.txt"""
 
-SUMMARY = """\
-{
+SUMMARY = f"""\
+{{
   echo '## Advisory marks (public tests)'
   echo
   if [ -s results/marks.txt ] && [ "$GRADE" = success ]; then
-    echo "The official mark is the instructor's re-grade (or Gradescope). Grader: $GRADER."
+    if [ "$SOURCE" = course ]; then
+      echo "Grader: the course repository $COURSE_REPOSITORY at $COURSE_REF, whose copy ran here. This" \\
+           "repository's grader, public tests and workflow were compared with it entry by entry:" \\
+           "identical, with no link."
+    else
+      echo "Grader: this repository's own copy, identical to its manifest {GRADER_MANIFEST} (SHA-256" \\
+           "$GRADER_DIGEST, recorded in this workflow), with no link. No course repository is named, so it" \\
+           "was compared with nothing the student cannot rewrite: compare that digest with the course's."
+    fi
     echo
     echo '```'
     cat results/marks.txt
     echo '```'
   elif [ "$COURSE" = failure ]; then
-    echo "Grading did not run: the course repository $COURSE_REPOSITORY could not be checked out." \\
-         "If it is private, the instructor adds a read-only token as the secret PCL_COURSE_TOKEN."
-  elif [ "$HASHES" = failure ]; then
-    echo "Grading did not run: this repository's grader (grading/, tests/graded/, pyproject.toml)" \\
-         "differs from the release. Restore those files."
+    echo "Grading did not run: the course repository $COURSE_REPOSITORY could not be checked out at" \\
+         "$COURSE_REF. If it is private, the instructor adds a read-only token as the secret" \\
+         "PCL_COURSE_TOKEN; the release's commit must carry the tag $COURSE_REF."
+  elif [ "$COMPARE" = failure ] || [ "$HASHES" = failure ]; then
+    echo "Grading did not run: this repository's grader ({", ".join(GRADER_FILES)}) is not the" \\
+         "release's, or holds a link. Restore those files as released (the course repository's):"
+    echo
+    echo '```'
+    head -n 25 {CHECKED} 2> /dev/null || true
+    echo '```'
   elif [ "$SETUP" != success ]; then
     echo "Grading did not run: the set-up step failed ($SETUP); see its log."
   else
     echo "Grading failed ($GRADE); see the grading step's log."
   fi
-} >> "$GITHUB_STEP_SUMMARY"
+  echo
+  echo "What this does not prove: this workflow runs from this repository, and whoever can push to it" \\
+       "can change the workflow itself, so this mark is advisory. The official mark is Gradescope's or" \\
+       "the instructor's re-grade, which read only the submission's pcl_course/ and never run its grader."
+}} >> "$GITHUB_STEP_SUMMARY"
 """
 
 
-def _student_workflow(course_repository):
+def course_tag(digest):
+    """The tag of the course repository's release commit, from its grader's manifest digest."""
+    return f"grader-{digest[:12]}"
+
+
+def _student_workflow(course_repository, digest, course_ref=None):
     """A plain GitHub Actions workflow (no GitHub Classroom): the advisory check.
 
-    ``course_repository`` (``OWNER/NAME``) is the instructor's student
-    repository whose grader and public tests are checked out pristine;
-    ``None`` reads it from the repository variable ``PCL_COURSE_REPOSITORY``,
-    and when that is empty too, the workflow grades with this repository's
-    own grader only if it matches :data:`GRADER_MANIFEST`, and says so.
+    Parameters
+    ----------
+    course_repository : str or None
+        ``OWNER/NAME`` of the instructor's student repository, checked out
+        at ``course_ref``: this repository's :data:`COMPARED` files must be
+        identical to its, and its copy grades. ``None`` reads it from the
+        repository variable ``PCL_COURSE_REPOSITORY``; when that is empty
+        too, the workflow grades with this repository's own grader only if
+        it matches :data:`GRADER_MANIFEST`, whose SHA-256 is ``digest``.
+    digest : str
+        The SHA-256 of the release's :data:`GRADER_MANIFEST`.
+    course_ref : str, optional
+        The course repository's tag or commit of this release (default
+        :func:`course_tag`); the repository variable ``PCL_COURSE_REF`` overrides it.
     """
     repository = course_repository or "${{ vars.PCL_COURSE_REPOSITORY }}"
     source = "steps.grader.outputs.source"
@@ -182,31 +227,41 @@ def _student_workflow(course_repository):
             "check": {
                 "runs-on": "ubuntu-24.04",
                 "timeout-minutes": 30,
-                "env": {"COURSE_REPOSITORY": repository},
+                "env": {
+                    "COURSE_REPOSITORY": repository,
+                    "COURSE_REF": f"${{{{ vars.PCL_COURSE_REF || '{course_ref or course_tag(digest)}' }}}}",
+                    "GRADER_DIGEST": digest,
+                },
                 "steps": [
                     {
                         "name": "Check out this repository (the submission)",
                         "uses": ACTIONS["checkout"],
-                        "with": {"path": "submission"},
+                        "with": {"path": "submission", "persist-credentials": False},
                     },
                     {"name": "Choose the grader", "id": "grader", "run": CHOOSE_GRADER},
                     {
-                        "name": "Check out the pristine course (its grader and public tests)",
+                        "name": "Check out the pristine course at the release's tag (its grader and public tests)",
                         "id": "course",
                         "if": f"{source} == 'course'",
                         "uses": ACTIONS["checkout"],
                         "with": {
                             "repository": "${{ env.COURSE_REPOSITORY }}",
-                            "ref": "${{ vars.PCL_COURSE_REF || 'main' }}",
+                            "ref": "${{ env.COURSE_REF }}",
                             "token": "${{ secrets.PCL_COURSE_TOKEN || github.token }}",
                             "path": "course",
+                            "persist-credentials": False,
                         },
                     },
                     {
-                        "name": "Or check this repository's grader against the release's hashes",
+                        "name": "Compare this repository's grader with the course's",
+                        "id": "compare",
+                        "if": f"{source} == 'course'",
+                        "run": COMPARE,
+                    },
+                    {
+                        "name": "Or check this repository's grader against the release's manifest",
                         "id": "hashes",
                         "if": f"{source} == 'hashes'",
-                        "working-directory": "submission",
                         "run": CHECK_HASHES,
                     },
                     {
@@ -228,9 +283,9 @@ def _student_workflow(course_repository):
                         "name": "Write the marks, or why there are none, to the summary",
                         "if": "always()",
                         "env": {
-                            "GRADER": f"${{{{ {source} == 'course' && env.COURSE_REPOSITORY "
-                            "|| 'this repository''s copy, identical to the release' }}",
+                            "SOURCE": f"${{{{ {source} }}}}",
                             "COURSE": "${{ steps.course.outcome }}",
+                            "COMPARE": "${{ steps.compare.outcome }}",
                             "HASHES": "${{ steps.hashes.outcome }}",
                             "SETUP": "${{ steps.setup.outcome }}",
                             "GRADE": "${{ steps.grade.outcome }}",
@@ -247,17 +302,23 @@ def _student_workflow(course_repository):
 def _grader_manifest(out):
     """``sha256sum`` lines of every file of :data:`GRADER_FILES` in the release."""
     files = []
-    for name in GRADER_FILES:
+    for name in GRADER_FILES:  # no link in the release: copytree copies a link's target
         path = out / name
         files += sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
     return "".join(f"{hashlib.sha256(p.read_bytes()).hexdigest()}  {p.relative_to(out).as_posix()}\n" for p in files)
 
 
-def release(out_dir, course_repository=None):
+def grader_digest(out):
+    """The SHA-256 of the release's :data:`GRADER_MANIFEST` (the digest the course publishes)."""
+    return hashlib.sha256((Path(out) / GRADER_MANIFEST).read_bytes()).hexdigest()
+
+
+def release(out_dir, course_repository=None, course_ref=None):
     """Write the student repository to ``out_dir``; return the list of leaks (empty when clean).
 
     ``course_repository`` (``OWNER/NAME``) is where the students' advisory
-    workflow checks out the pristine grader; see :func:`_student_workflow`.
+    workflow checks out the pristine grader, at ``course_ref`` (default: the
+    tag :func:`course_tag` names); see :func:`_student_workflow`.
     """
     out = Path(out_dir).resolve()
     if out.exists() and any(out.iterdir()):
@@ -278,8 +339,10 @@ def release(out_dir, course_repository=None):
     (out / "pyproject.toml").write_text(_student_pyproject((REPO_ROOT / "pyproject.toml").read_text()))
     for name in ("Makefile", "README.md"):
         shutil.copy2(TEMPLATES / name, out / name)
-    workflow = out / ".github" / "workflows" / "check.yml"
-    workflow.parent.mkdir(parents=True)
-    workflow.write_text(_student_workflow(course_repository))
+    (out / CHECK_SCRIPT).parent.mkdir(parents=True)
+    shutil.copy2(TEMPLATES / Path(CHECK_SCRIPT).name, out / CHECK_SCRIPT)
+    shutil.copytree(out / "pcl_course", out / PRISTINE)
     (out / GRADER_MANIFEST).write_text(_grader_manifest(out))
+    (out / WORKFLOW).parent.mkdir(parents=True)
+    (out / WORKFLOW).write_text(_student_workflow(course_repository, grader_digest(out), course_ref))
     return find_leaks(out)

@@ -2,7 +2,9 @@
 not, that its grader gives the stubs 0 points without an error, and that
 the reference's code is caught if it slips in."""
 
+import hashlib
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -118,17 +120,28 @@ def workflow_steps(text):
 
 
 def test_the_workflow_grades_with_a_pristine_grader_in_the_sandbox(release_dir):
+    from grading.instructors.release import GRADER_MANIFEST, grader_digest
+
     text = (release_dir / ".github" / "workflows" / "check.yml").read_text()
     assert "classroom" not in text.lower() and "advisory" in text.lower()
     workflow = yaml.safe_load(text)
-    assert workflow["jobs"]["check"]["env"]["COURSE_REPOSITORY"] == "${{ vars.PCL_COURSE_REPOSITORY }}"
+    env = workflow["jobs"]["check"]["env"]
+    assert env["COURSE_REPOSITORY"] == "${{ vars.PCL_COURSE_REPOSITORY }}"
+    # The release records its manifest's digest, and the course's tag named after it.
+    digest = grader_digest(release_dir)
+    assert digest == hashlib.sha256((release_dir / GRADER_MANIFEST).read_bytes()).hexdigest()
+    assert env["GRADER_DIGEST"] == digest
+    assert env["COURSE_REF"] == f"${{{{ vars.PCL_COURSE_REF || 'grader-{digest[:12]}' }}}}"
     steps = workflow_steps(text)
     uses = {step["uses"].split("@")[0]: step["uses"].split("@")[1] for step in steps.values() if "uses" in step}
     assert uses == {"actions/checkout": "v6", "actions/setup-python": "v6"}
-    # A private course repository is read with the instructors' token.
+    # A private course repository is read with the instructors' token, at the release's tag.
     assert steps["course"]["with"]["token"] == "${{ secrets.PCL_COURSE_TOKEN || github.token }}"
-    assert steps["course"]["if"] == "steps.grader.outputs.source == 'course'"
+    assert steps["course"]["with"]["ref"] == "${{ env.COURSE_REF }}"
+    assert steps["course"]["if"] == steps["compare"]["if"] == "steps.grader.outputs.source == 'course'"
     assert steps["hashes"]["if"] == "steps.grader.outputs.source == 'hashes'"
+    # The course's check script judges this repository's grader, not this repository's own script.
+    assert "python3 -I course/.github/check_grader.py submission" in steps["compare"]["run"]
     python = next(step for step in steps.values() if step.get("uses", "").startswith("actions/setup-python"))
     assert python["with"]["cache"] == "pip"
     assert steps["grade"]["working-directory"] == "course"
@@ -141,8 +154,9 @@ def test_the_workflow_grades_with_a_pristine_grader_in_the_sandbox(release_dir):
 def test_the_workflow_names_the_course_repository_when_given(tmp_path):
     from grading.instructors.release import _student_workflow
 
-    workflow = yaml.safe_load(_student_workflow("cs-dept/pcl-course-2027"))
+    workflow = yaml.safe_load(_student_workflow("cs-dept/pcl-course-2027", "ab" * 32, "v2027.1"))
     assert workflow["jobs"]["check"]["env"]["COURSE_REPOSITORY"] == "cs-dept/pcl-course-2027"
+    assert workflow["jobs"]["check"]["env"]["COURSE_REF"] == "${{ vars.PCL_COURSE_REF || 'v2027.1' }}"
 
 
 def run_step(step, cwd, env=None, timeout=STEP_BACKSTOP):
@@ -156,38 +170,154 @@ def run_step(step, cwd, env=None, timeout=STEP_BACKSTOP):
     )
 
 
-def test_the_workflow_trusts_its_own_grader_only_as_released(release_dir, tmp_path):
+PRISTINE_COPY = shutil.ignore_patterns("_build", "r.json", "results", "__pycache__", ".git")
+
+
+@pytest.fixture(scope="module")
+def course_clone(release_dir, tmp_path_factory):
+    """The course repository as the workflow checks it out: a git clone of the release as committed."""
+    source = tmp_path_factory.mktemp("course") / "source"
+    shutil.copytree(release_dir, source, ignore=PRISTINE_COPY)
+    git = ["git", "-c", "user.name=course", "-c", "user.email=course@example.org", "-c", "init.defaultBranch=main"]
+    for command in (["init", "-q"], ["add", "-A"], ["commit", "-q", "-m", "release"]):
+        subprocess.run([*git, *command], cwd=source, check=True, capture_output=True, timeout=STEP_BACKSTOP)
+    clone = source.parent / "clone"
+    subprocess.run(
+        [*git, "clone", "-q", str(source), str(clone)], check=True, capture_output=True, timeout=STEP_BACKSTOP
+    )
+    return clone
+
+
+def _regenerate_manifest(submission):
+    from grading.instructors.release import GRADER_MANIFEST, _grader_manifest
+
+    (submission / GRADER_MANIFEST).write_text(_grader_manifest(submission))
+
+
+# How a student's copy of the grader may differ from the release, and a word of the line that says so.
+TAMPERING = {
+    "linked module": (lambda s: (s / "grading" / "mistakes.py").symlink_to("../pcl_course/pca.py"), "symbolic link"),
+    "linked folder": (lambda s: (s / "grading" / "instructors").symlink_to("../pcl_course"), "symbolic link"),
+    "linked file replaced": (
+        lambda s: ((s / "grading" / "plugin.py").unlink(), (s / "grading" / "plugin.py").symlink_to("cli.py")),
+        "symbolic link",
+    ),
+    "linked parent": (
+        lambda s: (shutil.move(s / "tests", s / "elsewhere"), (s / "tests").symlink_to("elsewhere")),
+        "symbolic link",
+    ),
+    "fifo": (lambda s: os.mkfifo(s / "grading" / "checks" / "extra.py"), "FIFO"),
+    "hard link": (lambda s: os.link(s / "grading" / "config.py", s / "pcl_course" / "config.py"), "hard link"),
+    "hidden name": (lambda s: (s / "grading" / "\x1b[2Kx.py").write_text(""), "unprintable"),
+    "edited": (
+        lambda s: (s / "tests" / "graded" / "test_pca.py").write_text("def test_free(impl):\n    pass\n"),
+        "differs",
+    ),
+    "edited, manifest regenerated": (
+        lambda s: ((s / "grading" / "plugin.py").write_text("raise SystemExit(0)\n"), _regenerate_manifest(s)),
+        "not the release's|differs",
+    ),
+    "pins edited, manifest regenerated": (
+        lambda s: ((s / "requirements" / "grading.txt").write_text("numpy-hacked\n"), _regenerate_manifest(s)),
+        "not the release's|differs",
+    ),
+    "stubs edited, manifest regenerated": (
+        lambda s: ((s / ".github" / "pristine" / "pcl_course" / "pca.py").write_text(""), _regenerate_manifest(s)),
+        "not the release's|differs",
+    ),
+    "added": (lambda s: (s / "tests" / "graded" / "conftest.py").write_text(""), "added"),
+    "compiled": (
+        lambda s: (
+            (s / "grading" / "__pycache__").mkdir(),
+            (s / "grading" / "__pycache__" / "plugin.pyc").write_bytes(b""),
+        ),
+        "added",
+    ),
+    "empty folder": (lambda s: (s / "grading" / "instructors").mkdir(), "added"),
+    "removed": (lambda s: (s / "grading" / "forbidden.py").unlink(), "missing"),
+}
+
+
+def _workspace(release_dir, tmp_path, change):
+    """The runner's workspace: this repository, as released or changed, checked out in ``submission/``."""
+    submission = tmp_path / "submission"
+    shutil.copytree(release_dir, submission, ignore=PRISTINE_COPY)
+    if change is not None:
+        TAMPERING[change][0](submission)
+    return submission
+
+
+def _check(release_dir, course_clone, tmp_path, mode, change):
     steps = workflow_steps((release_dir / ".github" / "workflows" / "check.yml").read_text())
-    chosen = run_step(steps["grader"], tmp_path, {"COURSE_REPOSITORY": "", "GITHUB_OUTPUT": str(tmp_path / "out")})
-    assert chosen.returncode == 0 and (tmp_path / "out").read_text() == "source=hashes\n"
-    for change in (None, "edited", "added", "removed"):
-        workspace = tmp_path / str(change)
-        submission = workspace / "submission"
-        shutil.copytree(release_dir, submission, ignore=shutil.ignore_patterns("_build", "r.json", "__pycache__"))
-        if change == "edited":
-            (submission / "tests" / "graded" / "test_pca.py").write_text("def test_free(impl):\n    pass\n")
-        elif change == "added":
-            (submission / "tests" / "graded" / "conftest.py").write_text("")
-        elif change == "removed":
-            (submission / "grading" / "forbidden.py").unlink()
-        completed = run_step(steps["hashes"], submission)
-        if change is None:
-            assert completed.returncode == 0, completed.stdout + completed.stderr
-            assert (workspace / "course" / "tests" / "graded" / "test_pca.py").is_file()
-            assert (workspace / "course" / "grading" / "plugin.py").is_file()
-        else:
-            assert completed.returncode == 1, change
-            assert "differs from the release" in completed.stdout, change
-            assert not (workspace / "course").exists()
+    env = {
+        "GRADER_DIGEST": yaml.safe_load((release_dir / ".github" / "workflows" / "check.yml").read_text())["jobs"][
+            "check"
+        ]["env"]["GRADER_DIGEST"]
+    }
+    _workspace(release_dir, tmp_path, change)
+    if mode == "course":
+        shutil.copytree(course_clone, tmp_path / "course", symlinks=True)
+        return run_step(steps["compare"], tmp_path, env)
+    return run_step(steps["hashes"], tmp_path, env)
+
+
+@pytest.mark.parametrize("mode", ["course", "hashes"])
+def test_the_workflow_grades_a_pristine_release_with_the_released_grader(release_dir, course_clone, tmp_path, mode):
+    completed = _check(release_dir, course_clone, tmp_path, mode, None)
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    assert "identical to" in (tmp_path / "grader-check.txt").read_text()
+    course = tmp_path / "course"
+    assert (course / "tests" / "graded" / "test_pca.py").is_file() and (course / "grading" / "plugin.py").is_file()
+    # The grader's own pcl_course is the released stubs, never the submission's.
+    assert (course / "pcl_course" / "pca.py").read_bytes() == (release_dir / "pcl_course" / "pca.py").read_bytes()
+
+
+@pytest.mark.parametrize("mode", ["course", "hashes"])
+@pytest.mark.parametrize("change", sorted(TAMPERING))
+def test_the_workflow_refuses_a_grader_that_is_not_the_release(release_dir, course_clone, tmp_path, mode, change):
+    completed = _check(release_dir, course_clone, tmp_path, mode, change)
+    assert completed.returncode == 1, completed.stdout + completed.stderr
+    lines = completed.stdout.splitlines()
+    assert lines[0].startswith("::error::this repository's grader differs from"), completed.stdout
+    assert re.search(TAMPERING[change][1], completed.stdout), completed.stdout
+    assert completed.stdout == (tmp_path / "grader-check.txt").read_text()  # for the summary
+    if mode == "hashes":
+        assert not (tmp_path / "course").exists()  # nothing to grade with
+
+
+def test_the_students_submission_never_becomes_the_graders_stubs(release_dir, course_clone, tmp_path):
+    # A submission's pcl_course/ is graded in the sandbox; the grader imports its own stubs' signatures.
+    submission = _workspace(release_dir, tmp_path, None)
+    (submission / "pcl_course" / "pca.py").write_text("import os\nos._exit(0)\n")
+    for mode in ("course", "hashes"):
+        shutil.rmtree(tmp_path / "course", ignore_errors=True)
+        steps = workflow_steps((release_dir / ".github" / "workflows" / "check.yml").read_text())
+        if mode == "course":
+            shutil.copytree(course_clone, tmp_path / "course", symlinks=True)
+        digest = yaml.safe_load((release_dir / ".github" / "workflows" / "check.yml").read_text())["jobs"]["check"][
+            "env"
+        ]["GRADER_DIGEST"]
+        completed = run_step(steps[mode if mode == "hashes" else "compare"], tmp_path, {"GRADER_DIGEST": digest})
+        assert completed.returncode == 0, completed.stdout + completed.stderr
+        stubs = (tmp_path / "course" / "pcl_course" / "pca.py").read_bytes()
+        assert stubs == (release_dir / "pcl_course" / "pca.py").read_bytes(), mode
 
 
 @pytest.mark.parametrize(
     "outcomes, expected",
     [
-        ({"COURSE": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "PCL_COURSE_TOKEN"),
-        ({"HASHES": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "differs from the release"),
-        ({"HASHES": "success", "SETUP": "failure", "GRADE": "skipped"}, "the set-up step failed"),
-        ({"HASHES": "success", "SETUP": "success", "GRADE": "success"}, "Total: 1 / 2"),
+        ({"SOURCE": "course", "COURSE": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "PCL_COURSE_TOKEN"),
+        ({"SOURCE": "course", "COURSE": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "the tag grader-x"),
+        ({"SOURCE": "hashes", "HASHES": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "is a symbolic link"),
+        ({"SOURCE": "course", "COMPARE": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "is a symbolic link"),
+        ({"SOURCE": "hashes", "HASHES": "success", "SETUP": "failure", "GRADE": "skipped"}, "the set-up step failed"),
+        ({"SOURCE": "hashes", "HASHES": "success", "SETUP": "success", "GRADE": "success"}, "Total: 1 / 2"),
+        # What the check compared, and what it does not prove.
+        ({"SOURCE": "course", "SETUP": "success", "GRADE": "success"}, "a/b at grader-x, whose copy ran here"),
+        ({"SOURCE": "hashes", "SETUP": "success", "GRADE": "success"}, "compared with nothing the student cannot"),
+        ({"SOURCE": "hashes", "SETUP": "success", "GRADE": "success"}, "SHA-256 0123abc"),
+        ({"SOURCE": "course", "SETUP": "success", "GRADE": "success"}, "can change the workflow itself"),
+        ({"SOURCE": "hashes", "HASHES": "failure", "SETUP": "skipped", "GRADE": "skipped"}, "advisory"),
     ],
 )
 def test_the_workflow_summary_says_why_grading_did_not_run(release_dir, tmp_path, outcomes, expected):
@@ -196,10 +326,27 @@ def test_the_workflow_summary_says_why_grading_did_not_run(release_dir, tmp_path
     if outcomes["GRADE"] == "success":
         (tmp_path / "results").mkdir()
         (tmp_path / "results" / "marks.txt").write_text("Total: 1 / 2\n")
-    env = {"COURSE": "", "HASHES": "", "GRADER": "x", "COURSE_REPOSITORY": "a/b", **outcomes}
+    if "failure" in (outcomes.get("HASHES"), outcomes.get("COMPARE")):
+        (tmp_path / "grader-check.txt").write_text("::error::...\ngrading/mistakes.py is a symbolic link\n")
+    env = {"COURSE": "", "COMPARE": "", "HASHES": "", "COURSE_REPOSITORY": "a/b", "COURSE_REF": "grader-x"}
+    env = {**env, "GRADER_DIGEST": "0123abc", **outcomes}
     completed = run_step(summary, tmp_path, {**env, "GITHUB_STEP_SUMMARY": str(tmp_path / "summary.md")})
     assert completed.returncode == 0, completed.stderr
     assert expected in (tmp_path / "summary.md").read_text()
+
+
+def test_the_students_grader_refuses_to_run_with_a_link_in_it(release_dir, tmp_path):
+    copy = tmp_path / "copy"
+    shutil.copytree(release_dir, copy, ignore=PRISTINE_COPY)
+    (copy / "grading" / "instructors").symlink_to("../pcl_course")  # would pass for the instructors' grader
+    env = {**os.environ, "PYTHONPATH": str(copy)}
+    for command in (["-m", "grading", "grade", "."], ["-m", "pytest", "tests/graded", "-p", "no:cacheprovider"]):
+        completed = subprocess.run(
+            [sys.executable, *command], cwd=copy, capture_output=True, text=True, timeout=SUBPROCESS_BACKSTOP, env=env
+        )
+        assert completed.returncode != 0, command
+        assert "refusing to" in completed.stdout + completed.stderr, completed.stdout + completed.stderr
+        assert "grading/instructors is not a regular file or folder" in completed.stdout + completed.stderr
 
 
 def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
