@@ -283,6 +283,20 @@ def _write_json(path, content):
     os.replace(temporary, path)
 
 
+def seal_platform_files(root):
+    """Make everything Gradescope put in the container (``root``: its upload, the course's
+    source, ``submission_metadata.json`` with every earlier submission's results, hidden tests
+    included) and everything the grader writes there readable by root only.
+
+    The submission runs as another uid (or in bubblewrap, where none of it exists); the
+    grader and Gradescope's harness run as root.
+    """
+    os.chmod(root, 0o700)
+    for entry in Path(root).iterdir():
+        if entry.is_file() and not entry.is_symlink():
+            os.chmod(entry, 0o600)
+
+
 def autograde(root="/autograder", budget=None, assignment="lecture1"):
     """Grade ``root/submission`` into ``root/results/results.json``; return the exit status.
 
@@ -293,13 +307,14 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
     or a container where it cannot be isolated) still gets a results file,
     with score 0 and one line that says why.
     """
-    from grading.sandbox import isolation
+    from grading.sandbox import isolation, protect
 
     started = time.monotonic()
     root = Path(root)
     results = root / "results" / "results.json"
     results.parent.mkdir(parents=True, exist_ok=True)
-    os.chmod(results.parent, 0o755)  # written by the grader only: never by the submission's uid
+    seal_platform_files(root)
+    protect(root)  # the permission probe checks, as the sandbox uid, that none of it can be read
     level = isolation()
     if not level.isolated:
         message = (

@@ -36,6 +36,8 @@ from grading.sandbox.walls import (
     make_reachable,
     network_wall,
     permission_wall,
+    protect,
+    protected_paths,
     remove_files_of,
     reserve_uid,
 )
@@ -60,6 +62,8 @@ __all__ = [
     "network_wall",
     "permission_wall",
     "process_limit",
+    "protect",
+    "protected_paths",
     "remove_files_of",
     "reserve_uid",
     "set_generator_state",

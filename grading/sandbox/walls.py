@@ -11,7 +11,10 @@
     reserved by :func:`reserve_uid`) and the grader bars every sandbox uid
     from the forbidden packages with a POSIX ACL (:func:`bar_sandbox_uids`),
     then checks, as that uid, that the course's tests, solutions and
-    ``.git`` and those packages cannot be read (:func:`permission_wall`),
+    ``.git``, those packages and the files of the grading itself (the
+    platform's, such as Gradescope's ``/autograder`` with its record of
+    earlier results; ``batch``'s class folder and reports: :func:`protect`)
+    cannot be read (:func:`permission_wall`),
     and that a seccomp filter closes the network (:func:`network_wall`; the
     worker refuses to run without it). Everything that uid left running is
     killed after each worker, and every file it owns in the world-writable
@@ -48,6 +51,30 @@ from grading.sandbox.bubblewrap import (
 from grading.sandbox.processes import become_subreaper, kill_uid, preexec
 
 PROTECTED = ("tests", "solutions", ".git")  # of the course copy: never readable by a submission
+# Folders of the grading's own (the platform's: Gradescope's /autograder, with its
+# submission_metadata.json of earlier results; batch's class folder and reports), named by the
+# command that grades in PCL_PROTECTED_PATHS (os.pathsep-separated) so that the grading process
+# it starts probes them too.
+PROTECTED_PATHS_VARIABLE = "PCL_PROTECTED_PATHS"
+
+
+def protect(*paths):
+    """Name ``paths`` (folders or files) as never readable by a sandbox uid: the permission
+    probe (:func:`permission_wall`, run by :func:`isolation`) checks them, in this process and
+    in every grading process it starts."""
+    named = [p for p in os.environ.get(PROTECTED_PATHS_VARIABLE, "").split(os.pathsep) if p]
+    named += [str(Path(path).resolve()) for path in paths if str(Path(path).resolve()) not in named]
+    os.environ[PROTECTED_PATHS_VARIABLE] = os.pathsep.join(named)
+    isolation.cache_clear()
+
+
+def protected_paths():
+    """Every existing path a submission must not read: the course copy's :data:`PROTECTED`
+    folders and the paths named by :func:`protect`."""
+    course = [REPO_ROOT / name for name in PROTECTED]
+    named = [Path(p) for p in os.environ.get(PROTECTED_PATHS_VARIABLE, "").split(os.pathsep) if p]
+    return [path for path in [*course, *named] if path.exists()]
+
 
 BUBBLEWRAP, UID, NONE = "bubblewrap", "uid", "none"
 
@@ -264,6 +291,8 @@ def permission_wall(uid, protected):
     if readable:
         if readable[0] in {str(p) for p in masked_paths()}:
             return f"uid {uid} can still read the forbidden package {readable[0]}"
+        if not Path(readable[0]).is_relative_to(REPO_ROOT):
+            return f"uid {uid} can read {readable[0]}: make it unreadable to others (chmod 700)"
         return (
             f"uid {uid} can read {readable[0]}: make the course folder {REPO_ROOT} unreadable to others "
             f"(chmod 700) and keep the Python environment outside it"
@@ -325,7 +354,8 @@ def isolation(uid=None):
         ``bubblewrap`` if a worker starts in it (unless
         :data:`grading.config.SANDBOX_NAMESPACES` is off); else ``uid`` if
         the grader is root and the dedicated uid can read none of the
-        course's :data:`PROTECTED` folders; else ``none``, with the reasons.
+        course's :data:`PROTECTED` folders nor the paths named by :func:`protect`
+        (the platform's files, the class's folder); else ``none``, with the reasons.
     """
     root = os.geteuid() == 0
     uid = reserve_uid(uid) if root else None
@@ -345,8 +375,7 @@ def isolation(uid=None):
     barred = bar_sandbox_uids(masked_paths())
     if barred is not None:
         return Isolation(NONE, None, f"{why_not}; {barred}")
-    protected = [REPO_ROOT / name for name in PROTECTED if (REPO_ROOT / name).exists()]
-    wall = permission_wall(uid, [*protected, *masked_paths()])
+    wall = permission_wall(uid, [*protected_paths(), *masked_paths()])
     if wall is not None:
         return Isolation(NONE, None, f"{why_not}; {wall}")
     network = network_wall(uid)

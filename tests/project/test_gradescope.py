@@ -298,3 +298,35 @@ def test_the_sandbox_uid_reaches_no_forbidden_package_no_path_and_leaves_nothing
     assert not [path for path in left if os.path.lexists(path)]
     isolation = results["grading"].isolation
     assert isolation.startswith("isolated: bubblewrap" if namespaces else "isolated: dedicated uid"), isolation
+
+
+@needs_root
+@pytest.mark.parametrize("namespaces", [True, False], ids=["bubblewrap", "uid"])
+def test_the_platforms_files_and_earlier_results_are_out_of_reach(archive, tmp_path, namespaces):
+    """Gradescope writes submission_metadata.json, with every earlier submission's results
+    (hidden tests included), world-readable into the container: the grader seals the platform's
+    folder before grading, and its permission probe checks it."""
+    root = autograder_root(archive, tmp_path / "autograder")
+    metadata = root / "submission_metadata.json"
+    metadata.write_text(json.dumps({"previous_submissions": [{"score": 71.5, "results": {"tests": []}}]}))
+    for path in (root, metadata, root / "submission", root / "results"):
+        path.chmod(0o755 if path.is_dir() else 0o644)
+    make_reachable(root / "results")
+    readable = [str(metadata), str(root / "results"), str(root / "submission"), str(root)]
+    (root / "submission" / "metrics.py").write_text(SPY % {"readable": readable, "writable": [], "port": 9})
+    results, _ = run_autograder(root, namespaces=namespaces)
+    outputs = [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance" and "SPY" in t["text"]]
+    assert outputs, [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance"]
+    found = json.loads(outputs[0][outputs[0].index("SPY") + 3 : outputs[0].index("YPS")])
+    assert found["readable"] == [], found
+
+
+def test_the_permission_probe_checks_the_platforms_folder(tmp_path, monkeypatch):
+    from grading.sandbox import protect, protected_paths
+    from grading.sandbox.walls import PROTECTED_PATHS_VARIABLE
+
+    monkeypatch.delenv(PROTECTED_PATHS_VARIABLE, raising=False)
+    assert tmp_path not in protected_paths()
+    protect(tmp_path)
+    assert tmp_path.resolve() in protected_paths()  # and every grading process started from here
+    assert str(tmp_path.resolve()) in os.environ[PROTECTED_PATHS_VARIABLE].split(os.pathsep)
