@@ -33,8 +33,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, EXERCISE_MODULES, REPO_ROOT
+from grading.config import MAX_TEXT
 from grading.errors import StagingError
 from grading.instructors.leakcheck import find_leaks
+from grading.instructors.reports import say
 from grading.instructors.shipping import IGNORED, cut_reference_link
 from grading.results import Grading, clean
 from grading.runner import run_graded_tests
@@ -359,9 +361,9 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
         except StagingError as exc:
             message = f"submission refused: {exc}"
             _write_json(results, _failure_results(message, started))
-            print(message)
+            say(message)  # names the submission's files: escaped, as every text a student chose
             return 0
-        print(note)
+        say(note)
         remaining = None if budget is None else max(0.0, budget - (time.monotonic() - started))
         code, output = run_graded_tests(
             package,
@@ -372,7 +374,7 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
             budget=remaining,
             function=list(ASSIGNMENTS[assignment]),
         )
-        print(output)
+        say(output, newlines=True, limit=max(MAX_TEXT, 6 * len(output)))
         if code not in (0, 1) or not results.exists():
             message = f"The grading run broke (pytest exit code {code}): tell your instructor."
             _write_json(results, _failure_results(message, started))

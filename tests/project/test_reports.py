@@ -258,3 +258,18 @@ def test_an_ambiguous_roster_match_is_refused_and_listed_never_guessed(tmp_path)
     refused = [line for line in stdout.splitlines() if "refused, ambiguous" in line]
     assert any(line.startswith("submission_1: ") and "2 roster rows" in line for line in refused), stdout
     assert any(line.startswith("Bob [bob02]: ") and "submission_1, submission_2" in line for line in refused), stdout
+
+
+def test_gradescope_prints_a_refused_submissions_file_names_escaped(tmp_path, capsys):
+    """``autograde``'s log names the files of a refused upload: escaped, as in the reports."""
+    from grading.instructors.gradescope import autograde
+    from grading.sandbox import isolation
+
+    if not isolation().isolated:
+        pytest.skip("autograde refuses every submission first where it cannot isolate one")
+    for name in ("a\x1b]0;owned\x07", "b\u202egnp"):  # two pcl_course/ as deep: refused, both named
+        (tmp_path / "submission" / name / "pcl_course").mkdir(parents=True)
+    assert autograde(tmp_path, assignment="lecture1") == 0
+    printed = capsys.readouterr().out
+    assert "several pcl_course/ folders" in printed and not unsafe(printed), printed
+    assert "a\\x1b]0;owned\\x07/pcl_course" in printed
