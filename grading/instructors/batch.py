@@ -65,33 +65,49 @@ class MetadataError(ValueError):
 
 
 class _MetadataLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, refusing anchors and aliases, its tree bounded in depth and size.
+    """PyYAML's safe loader, its tree bounded in depth and in size, each alias counted as what it repeats.
 
     An alias repeats a whole subtree for a few bytes ("billion laughs"): a
     576-byte file of merge keys of merge keys took the old reader past 1 GiB
-    of address space. Gradescope's export has none. The composer is PyYAML's
-    own, checked at each node before it is built.
+    of address space. Ruby's YAML, which writes Gradescope's export, may
+    write an alias where an object repeats, so aliases are read, but each
+    counts as many values as the subtree it stands for: the tree as the
+    program sees it, expanded, holds at most
+    :data:`grading.config.METADATA_MAX_NODES` values. An alias to a node
+    still being read (a loop) is refused. The composer is PyYAML's own,
+    checked at each node before it is built.
     """
 
     def __init__(self, stream):
         super().__init__(stream)
         self._depth = 0
         self._nodes = 0
+        self._sizes = {}  # anchor -> values of its subtree, expanded
+
+    def _count(self, values):
+        self._nodes += values
+        if self._nodes > config.METADATA_MAX_NODES:
+            raise MetadataError(f"more than {config.METADATA_MAX_NODES} values (an alias counts as what it repeats)")
 
     def compose_node(self, parent, index):
         event = self.peek_event()
-        if isinstance(event, yaml.AliasEvent) or event.anchor is not None:
-            raise MetadataError(f"an anchor or alias on line {event.start_mark.line + 1} (refused)")
-        self._nodes += 1
-        if self._nodes > config.METADATA_MAX_NODES:
-            raise MetadataError(f"more than {config.METADATA_MAX_NODES} values")
+        if isinstance(event, yaml.AliasEvent):
+            if event.anchor in self.anchors and event.anchor not in self._sizes:
+                raise MetadataError(f"an alias inside its own anchor on line {event.start_mark.line + 1}")
+            self._count(self._sizes.get(event.anchor, 1))
+            return super().compose_node(parent, index)
+        self._count(1)
         if self._depth >= config.METADATA_MAX_DEPTH:
             raise MetadataError(f"values nested more than {config.METADATA_MAX_DEPTH} deep")
+        before = self._nodes
         self._depth += 1
         try:
-            return super().compose_node(parent, index)
+            node = super().compose_node(parent, index)
         finally:
             self._depth -= 1
+        if event.anchor is not None:
+            self._sizes[event.anchor] = self._nodes - before + 1
+        return node
 
 
 def _read_bounded(path, limit):
@@ -111,8 +127,8 @@ def load_metadata(data):
     Raises
     ------
     MetadataError
-        Not UTF-8, not YAML, an anchor or alias, too many or too deeply nested
-        values, or anything else PyYAML's safe loader refuses.
+        Not UTF-8, not YAML, too many values (aliases expanded) or too deeply
+        nested, a looping alias, or anything else PyYAML's safe loader refuses.
     """
     try:
         text = data.decode("utf-8")

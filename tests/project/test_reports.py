@@ -166,7 +166,8 @@ HOSTILE_METADATA = {
     ),
     "not UTF-8": (b"submission_1:\n  :submitters:\n  - :name: Jos\xe9\n", "not UTF-8 text"),
     "deep nesting": (b"submission_1: " + b"[" * 5000 + b"]" * 5000 + b"\n", "nested more than"),
-    "an alias bomb": (BOMB, "an anchor or alias"),
+    "an alias bomb": (BOMB, "more than 100000 values (an alias counts as what it repeats)"),
+    "a looping alias": (b"submission_1: &loop\n  :submitters: *loop\n", "an alias inside its own anchor"),
 }
 
 
@@ -204,6 +205,14 @@ def test_the_metadata_caps_of_the_readme_hold(tmp_path):
         path.write_bytes(data)
         people, problems = read_gradescope_metadata(tmp_path)
         assert len(problems) == 1 and reason in problems[0], (reason, problems)
+    # Aliases that repeat little are read (Ruby's YAML writes them where an object repeats).
+    path.write_text(
+        "submission_1:\n  :submitters:\n  - &ada\n    :name: Ada\n    :sid: S-1\n"
+        "submission_2:\n  :submitters:\n  - *ada\n"
+    )
+    people, problems = read_gradescope_metadata(tmp_path)
+    assert people["submission_2"] == people["submission_1"] == [{"name": "Ada", "sid": "S-1", "email": ""}]
+    assert problems == []
     # At the caps: read.
     path.write_bytes(record.format(name="x" * 320).encode() + b"submission_2: " + b"[" * 15 + b"]" * 15 + b"\n")
     people, problems = read_gradescope_metadata(tmp_path)
