@@ -136,6 +136,9 @@ def _student_modules(class_dir, into):
             except (SyntaxError, OSError) as exc:
                 reason = exc.msg if isinstance(exc, SyntaxError) else exc.strerror
                 skipped.append(f"{name}: {module}.py not compared: {reason}")
+                continue
+            if (assembled.package / module).is_dir():
+                skipped.append(f"{name}: {module}/ is a package: only its __init__.py compared")
         modules[name] = texts
     return modules, skipped
 
