@@ -208,16 +208,21 @@ def test_every_layout_graded_is_compared_as_python_decodes_it_and_every_entry_le
     (erin / "pca.py").write_bytes(("# caf\u00e9\n" + pca_source(DAVE)).encode("latin-1"))
     (tmp_path / "frank.txt").write_text("not a submission")
     (tmp_path / "gina").mkdir()  # an empty upload
+    ivan = student(tmp_path, "ivan")  # pca written as a package: its __init__.py only is compared
+    (ivan / "pca.py").rename(ivan / "pca_init.py")
+    (ivan / "pca").mkdir()
+    (ivan / "pca_init.py").rename(ivan / "pca" / "__init__.py")
     pairs, skipped = compare_class(tmp_path)
     similarity = {(p.module, p.first, p.second): p.similarity for p in pairs}
     found = {pair: similarity.get(("pca", *pair), 0) for pair in [("alice", "bob"), ("carol", "dave")]}
     assert min(found.values()) > 0.9, (found, similarity, skipped)
     copies = {("alice", "bob"), ("carol", "dave")}
     assert all(s < DISPLAY_THRESHOLD for key, s in similarity.items() if key[1:] not in copies), similarity
-    assert len(skipped) == 3, skipped
+    assert len(skipped) == 4, skipped
     assert skipped[0].startswith("erin: pca.py not compared: its bytes cannot be decoded as Python decodes them")
     assert skipped[1] == "frank.txt: not compared: not a folder (a link or a file)"
     assert skipped[2].startswith("gina: not compared: no pcl_course/ folder and none of pca.py")
+    assert skipped[3] == "ivan: pca/ is a package: only its __init__.py compared"
 
 
 def test_the_report_shows_students_control_characters_escaped():
