@@ -130,3 +130,13 @@ FORBIDDEN_IN_MODULE = {
         "pcl_course.neighbors",
     ),
 }
+
+# -- the instructors' reports (grading/instructors/) -------------------------------
+# Gradescope's submission_metadata.yml is read with these caps, an alias counted as
+# the values it repeats (a 576-byte "billion laughs" of merge keys took the old reader
+# past 1 GiB): a file past them identifies nobody, a record past them nobody of its
+# submission (graded under its folder's name, with one line that says why).
+METADATA_MAX_BYTES = 8 * 1024**2  # bytes of the file (a submission's record: about 200 bytes)
+METADATA_MAX_NODES = 100_000  # values, keys and collections, aliases expanded (PyYAML: about 2 s, 45 MiB)
+METADATA_MAX_DEPTH = 16  # nested values (Gradescope's: 5, a submitter's email)
+METADATA_MAX_FIELD = 320  # characters of one submitter's name, SID or email (an email: 254)

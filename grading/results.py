@@ -38,16 +38,23 @@ HIDDEN_NOTE = "(hidden test: details withheld)"
 # C0 and C1 control characters but newline, DEL, and the Unicode format characters
 # (bidirectional overrides, zero-width joiners) that reorder or hide what a terminal shows.
 _UNSAFE = re.compile(r"[\x00-\x09\x0b-\x1f\x7f-\x9f]")
+# Also escaped: lone surrogates (a file name's undecodable bytes, as os.fsdecode
+# keeps them: no file can encode them) and the line and paragraph separators.
+_UNSAFE_CATEGORIES = frozenset({"Cf", "Cs", "Zl", "Zp"})
 
 
 def _escape(character):
     code = ord(character)
+    if 0xDC80 <= code <= 0xDCFF:  # surrogateescape's stand-in for the byte code - 0xDC00
+        return f"\\x{code - 0xDC00:02x}"
     return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
 
 
 def clean(text, limit=MAX_TEXT, newlines=True):
     """``text`` made safe to print and to store: control and format characters
-    escaped (``\\x1b``, ``\\u202e``), at most ``limit`` characters.
+    escaped (``\\x1b``, ``\\u202e``; a file name's undecodable byte, kept by
+    :func:`os.fsdecode` as a lone surrogate, as ``\\xe9``), at most ``limit``
+    characters.
 
     Parameters
     ----------
@@ -62,7 +69,7 @@ def clean(text, limit=MAX_TEXT, newlines=True):
     if len(text) > 4 * limit:
         text = text[: 4 * limit]  # escaping at most quadruples a character: bound the work first
     text = _UNSAFE.sub(lambda m: _escape(m.group()), text)
-    text = "".join(_escape(c) if unicodedata.category(c) == "Cf" else c for c in text)
+    text = "".join(_escape(c) if unicodedata.category(c) in _UNSAFE_CATEGORIES else c for c in text)
     if not newlines:
         text = text.replace("\n", "\\n")
     return text if len(text) <= limit else text[: limit - 3] + "..."

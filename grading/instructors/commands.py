@@ -63,7 +63,11 @@ def _release_arguments(parser):
 
 
 def _similarity_arguments(parser):
-    parser.add_argument("directory", help="a folder with one student clone (holding pcl_course/) per subdirectory")
+    parser.add_argument(
+        "directory",
+        help="a folder with one submission per entry, in any layout batch grades "
+        "(a clone, its pcl_course/, loose modules, Gradescope's export)",
+    )
     parser.add_argument(
         "--report", default="similarity.html", help="the HTML report to write (default similarity.html)"
     )
@@ -137,6 +141,7 @@ def _autograde(args):
 
 
 def _similarity(args):
+    from grading.instructors.reports import say
     from grading.instructors.similarity import DISPLAY_THRESHOLD, compare_class, counted, render_report
 
     root = Path(args.directory)
@@ -145,13 +150,13 @@ def _similarity(args):
     threshold = DISPLAY_THRESHOLD if args.threshold is None else args.threshold
     pairs, skipped = compare_class(root)
     report = Path(args.report)
-    report.write_text(render_report(pairs, skipped, threshold, args.top))
+    report.write_text(render_report(pairs, skipped, threshold, args.top), encoding="utf-8")
     for line in skipped:
-        print(line)
+        say(line)
     shown = [p for p in pairs if p.similarity >= threshold][: args.top]
     for pair in shown[:10]:
-        print(f"{pair.similarity:4.0%}  {pair.module}.py  {pair.first}  {pair.second}")
-    print(f"{counted(len(shown), 'pair')} at or above {threshold:.0%}; report written to {report}")
+        say(f"{pair.similarity:4.0%}  {pair.module}.py  {pair.first}  {pair.second}")
+    say(f"{counted(len(shown), 'pair')} at or above {threshold:.0%}; report written to {report}")
     return 0
 
 

@@ -33,8 +33,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, EXERCISE_MODULES, REPO_ROOT
+from grading.config import MAX_TEXT
 from grading.errors import StagingError
 from grading.instructors.leakcheck import find_leaks
+from grading.instructors.reports import say
 from grading.instructors.shipping import IGNORED, cut_reference_link
 from grading.results import Grading, clean
 from grading.runner import run_graded_tests
@@ -207,15 +209,80 @@ def locate(submission):
     return located
 
 
-def assemble(submission, into, assignment=None):
+@dataclass
+class Assembled:
+    """A submission's code laid over the course's stubs (:func:`lay_over_stubs`).
+
+    Attributes
+    ----------
+    package : Path
+        The ``pcl_course/`` to grade: the stubs, the submission's files over them.
+    found : list of str
+        The exercise modules the submission holds (``pca``: its ``pca.py``,
+        or a package ``pca/``).
+    where : str
+        Where they were found: ``"pcl_course/"``, ``"the uploaded files"``, ``"code/"``.
+    ignored : list of str
+        Loose ``.py`` files that are not exercise modules (never graded).
+    """
+
+    package: Path
+    found: list
+    where: str
+    ignored: list = field(default_factory=list)
+
+
+def lay_over_stubs(submission, into):
     """Lay the submission's code over a pristine ``pcl_course/`` in ``into``.
+
+    The one reading of a submission's layout: ``assemble`` (Gradescope's
+    ``autograde``, ``batch``) and the similarity report call it. Every file
+    of the submission is read as staging reads it (regular files only, no
+    link followed, with caps): a link, a device or compiled code refuses the
+    whole submission.
+
+    Returns
+    -------
+    Assembled
+
+    Raises
+    ------
+    StagingError
+        When nothing gradable was found, or the submission cannot be staged.
+    """
+    submission = Path(submission)
+    located = locate(submission)
+    package = Path(into) / "pcl_course"
+    shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=IGNORED)
+    if located.package is not None:
+        staged = stage(located.package, Path(into) / "staged")
+        for relative in staged.files:
+            target = package / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(staged.package / relative, target)
+        shutil.rmtree(staged.root)
+        where = located.package.relative_to(submission).as_posix() + "/"
+        found = [m for m in EXERCISE_MODULES if f"{m}.py" in staged.files or f"{m}/__init__.py" in staged.files]
+    elif located.modules:
+        for name, path in located.modules.items():
+            (package / f"{name}.py").write_bytes(read_regular_file(path, f"{path.relative_to(submission)}"))
+        where = sorted({p.parent.relative_to(submission).as_posix() for p in located.modules.values()})
+        where = "the uploaded files" if where == ["."] else ", ".join(f"{w}/" for w in where)
+        found = list(located.modules)
+    else:
+        expected = ", ".join(f"{m}.py" for m in EXERCISE_MODULES)
+        raise StagingError(
+            f"no pcl_course/ folder and none of {expected} in the submission: "
+            "upload your repository, its pcl_course/ folder, or those files"
+        )
+    return Assembled(package, found, where, located.ignored)
+
+
+def assemble(submission, into, assignment=None):
+    """Lay the submission's code over a pristine ``pcl_course/`` in ``into`` (:func:`lay_over_stubs`).
 
     ``assignment`` (a key of :data:`grading.config.ASSIGNMENTS`) names the
     modules the note reports as found or missing; None: every exercise module.
-
-    Every file of the submission is read as staging reads it (regular files
-    only, no link followed, with caps): a link, a device or compiled code
-    refuses the whole submission.
 
     Returns
     -------
@@ -229,42 +296,20 @@ def assemble(submission, into, assignment=None):
     StagingError
         When nothing gradable was found, or the submission cannot be staged.
     """
-    submission = Path(submission)
     graded = ASSIGNMENT_MODULES[assignment] if assignment else EXERCISE_MODULES
-    located = locate(submission)
-    package = Path(into) / "pcl_course"
-    shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=IGNORED)
-    found = []
-    if located.package is not None:
-        staged = stage(located.package, Path(into) / "staged")
-        for relative in staged.files:
-            target = package / relative
-            target.parent.mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(staged.package / relative, target)
-        shutil.rmtree(staged.root)
-        where = located.package.relative_to(submission).as_posix() + "/"
-        found = [m for m in graded if f"{m}.py" in staged.files or f"{m}/__init__.py" in staged.files]
-    elif located.modules:
-        for name, path in located.modules.items():
-            (package / f"{name}.py").write_bytes(read_regular_file(path, f"{path.relative_to(submission)}"))
-        where = sorted({p.parent.relative_to(submission).as_posix() for p in located.modules.values()})
-        where = "the uploaded files" if where == ["."] else ", ".join(f"{w}/" for w in where)
-        found = [m for m in located.modules if m in graded]
-    else:
-        expected = ", ".join(f"{m}.py" for m in EXERCISE_MODULES)
-        raise StagingError(
-            f"no pcl_course/ folder and none of {expected} in the submission: "
-            "upload your repository, its pcl_course/ folder, or those files"
-        )
+    assembled = lay_over_stubs(submission, into)
+    found = [m for m in assembled.found if m in graded]
     missing = [m for m in graded if m not in found]
     note = (
-        f"Graded from {where}: " + (", ".join(f"`{m}.py`" for m in found) or "none of this assignment's modules") + "."
+        f"Graded from {assembled.where}: "
+        + (", ".join(f"`{m}.py`" for m in found) or "none of this assignment's modules")
+        + "."
     )
     if missing:
         note += " Missing (graded as the course's stub, 0 points): " + ", ".join(f"`{m}.py`" for m in missing) + "."
-    if located.ignored:
-        note += " Not graded (not exercise modules): " + ", ".join(f"`{n}`" for n in located.ignored) + "."
-    return package, note
+    if assembled.ignored:
+        note += " Not graded (not exercise modules): " + ", ".join(f"`{n}`" for n in assembled.ignored) + "."
+    return assembled.package, note
 
 
 # -- one submission, in the container -------------------------------------------------
@@ -331,9 +376,9 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
         except StagingError as exc:
             message = f"submission refused: {exc}"
             _write_json(results, _failure_results(message, started))
-            print(message)
+            say(message)  # names the submission's files: escaped, as every text a student chose
             return 0
-        print(note)
+        say(note)
         remaining = None if budget is None else max(0.0, budget - (time.monotonic() - started))
         code, output = run_graded_tests(
             package,
@@ -344,7 +389,7 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
             budget=remaining,
             function=list(ASSIGNMENTS[assignment]),
         )
-        print(output)
+        say(output, newlines=True, limit=max(MAX_TEXT, 6 * len(output)))
         if code not in (0, 1) or not results.exists():
             message = f"The grading run broke (pytest exit code {code}): tell your instructor."
             _write_json(results, _failure_results(message, started))

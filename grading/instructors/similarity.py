@@ -11,9 +11,13 @@ their hashes are removed before any comparison: the stubs' own text
 run found in more than half of the class's versions of the module (the
 way everyone writes ``as_points(points, ...)``), as MOSS's ``-m`` does.
 
-Each student's ``pcl_course/`` is read through :func:`grading.staging.stage`
-(regular files only, no link followed), so a link in a submission never
-puts another file's text into the report. The report is one self-contained
+Each entry of the class folder is read as ``batch`` and Gradescope read it
+(:func:`grading.instructors.gradescope.lay_over_stubs`: a clone, its
+``pcl_course/``, loose modules, a nested folder; regular files only, no
+link followed), so a link in a submission never puts another file's text
+into the report, and each module is decoded as Python decodes it (a PEP 263
+coding line honoured). Every entry or module not compared is listed, with why.
+Students' folder names are shown escaped (:func:`grading.results.clean`). The report is one self-contained
 HTML page (no script, no web font, no stylesheet fetched): the pairs ranked
 by similarity, each with both files side by side and the shared code
 highlighted. A high score is a reason to read the two files, not a verdict.
@@ -22,7 +26,6 @@ highlighted. A high score is a reason to read the two files, not a verdict.
 import html
 import io
 import itertools
-import os
 import shutil
 import tempfile
 from collections import Counter
@@ -35,7 +38,10 @@ from copydetect.utils import highlight_overlap
 
 from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
-from grading.staging import stage
+from grading.forbidden import read_source
+from grading.instructors.batch import class_folders
+from grading.instructors.gradescope import lay_over_stubs
+from grading.results import clean
 
 NOISE_TOKENS = 25  # copydetect's default k: shorter shared runs are noise
 # A fingerprint found in more than this share of a class's versions of a
@@ -94,20 +100,46 @@ def _common_hashes(module, texts, boilerplate):
     return np.unique(np.concatenate([np.asarray(boilerplate, dtype=np.int64), np.array(common, dtype=np.int64)]))
 
 
+def _module_text(package, module):
+    """The text of ``module`` in a laid-over ``package``, decoded as Python decodes it (or a SyntaxError)."""
+    inside = package / module / "__init__.py"
+    return read_source(inside if inside.is_file() else package / f"{module}.py")
+
+
 def _student_modules(class_dir, into):
-    """Stage each student's ``pcl_course/``; return ({student: {module: text}}, skipped lines)."""
+    """Read each entry as grading does; return ({student: {module: text}}, lines on what was not compared).
+
+    Every entry of the class folder (as ``batch`` lists them:
+    :func:`grading.instructors.batch.class_folders`) is laid over the stubs
+    as ``batch`` and Gradescope lay it (:func:`grading.instructors.gradescope.lay_over_stubs`:
+    a clone, its ``pcl_course/``, loose modules, a nested folder), so that
+    every layout graded is compared. Each module the submission holds is
+    decoded as the interpreter decodes it (:func:`grading.forbidden.read_source`:
+    a PEP 263 coding line such as ``utf-7`` is honoured); one Python would
+    not decode is not compared, with a line that says so.
+    """
     modules, skipped = {}, []
-    for student in sorted(p for p in Path(class_dir).iterdir() if os.path.lexists(p / "pcl_course")):
-        try:
-            staged = stage(student / "pcl_course", Path(into) / student.name)
-        except StagingError as exc:
-            skipped.append(f"{student.name}: not compared: {exc}")
+    for position, entry in enumerate(class_folders(Path(class_dir))):
+        name = entry.name
+        if entry.is_symlink() or not entry.is_dir():
+            skipped.append(f"{name}: not compared: not a folder (a link or a file)")
             continue
-        modules[student.name] = {
-            name: (staged.package / f"{name}.py").read_text(encoding="utf-8", errors="replace")
-            for name in EXERCISE_MODULES
-            if f"{name}.py" in staged.files
-        }
+        try:
+            assembled = lay_over_stubs(entry, Path(into) / str(position))
+        except StagingError as exc:
+            skipped.append(f"{name}: not compared: {exc}")
+            continue
+        texts = {}
+        for module in assembled.found:
+            try:
+                texts[module] = _module_text(assembled.package, module)
+            except (SyntaxError, OSError) as exc:
+                reason = exc.msg if isinstance(exc, SyntaxError) else exc.strerror
+                skipped.append(f"{name}: {module}.py not compared: {reason}")
+                continue
+            if (assembled.package / module).is_dir():
+                skipped.append(f"{name}: {module}/ is a package: only its __init__.py compared")
+        modules[name] = texts
     return modules, skipped
 
 
@@ -117,8 +149,9 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     Parameters
     ----------
     class_dir : path
-        One folder per student, each holding ``pcl_course/`` (the layout
-        of ``python -m grading batch``).
+        One entry per submission, in any layout ``python -m grading batch``
+        grades (a clone, its ``pcl_course/``, loose modules, Gradescope's
+        export).
     stubs : path
         The stubs whose text is boilerplate (default: the course's).
 
@@ -127,7 +160,7 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     pairs : list of Pair
         Every compared pair with shared code, most similar first.
     skipped : list of str
-        One line per submission that could not be read.
+        One line per entry, or module of an entry, that was not compared, with why.
     """
     boilerplate = _boilerplate_hashes(stubs)
     work = tempfile.mkdtemp(prefix="grading-similarity-")
@@ -178,26 +211,37 @@ def counted(n, noun):
     return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
+def _text(text):
+    """A student's text (a folder name, a line about it) as HTML: escaped, one line, no control character."""
+    return html.escape(clean(text, newlines=False))
+
+
+def _code(highlighted):
+    """A file's highlighted HTML with its control and format characters (a bidi override) shown escaped."""
+    text = highlighted.replace("\t", "    ")
+    return clean(text, limit=6 * len(text) + 3)
+
+
 def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
     """The report: one HTML page, self-contained."""
     shown = [pair for pair in pairs if pair.similarity >= threshold][:top]
     rows = "\n".join(
         f'<tr><td><a href="#pair-{i}">{i}</a></td><td>{html.escape(p.module)}.py</td>'
-        f"<td>{html.escape(p.first)}</td><td>{html.escape(p.second)}</td>"
+        f"<td>{_text(p.first)}</td><td>{_text(p.second)}</td>"
         f'<td class="number">{p.first_share:.0%}</td><td class="number">{p.second_share:.0%}</td>'
         f'<td class="number">{p.shared_tokens}</td></tr>'
         for i, p in enumerate(shown, start=1)
     )
     sections = "\n".join(
         f'<section class="pair" id="pair-{i}"><h2>{i}. {html.escape(p.module)}.py: '
-        f"{html.escape(p.first)} and {html.escape(p.second)} ({p.similarity:.0%})</h2>"
-        f'<div class="sides"><div><h3>{html.escape(p.first)} ({p.first_share:.0%} shared)</h3>'
-        f"<pre>{p.first_html}</pre></div>"
-        f"<div><h3>{html.escape(p.second)} ({p.second_share:.0%} shared)</h3>"
-        f"<pre>{p.second_html}</pre></div></div></section>"
+        f"{_text(p.first)} and {_text(p.second)} ({p.similarity:.0%})</h2>"
+        f'<div class="sides"><div><h3>{_text(p.first)} ({p.first_share:.0%} shared)</h3>'
+        f"<pre>{_code(p.first_html)}</pre></div>"
+        f"<div><h3>{_text(p.second)} ({p.second_share:.0%} shared)</h3>"
+        f"<pre>{_code(p.second_html)}</pre></div></div></section>"
         for i, p in enumerate(shown, start=1)
     )
-    notes = "".join(f"<li>{html.escape(line)}</li>" for line in skipped)
+    notes = "".join(f"<li>{_text(line)}</li>" for line in skipped)
     return f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>Similarity report</title>
 <style>{STYLE}</style></head><body>

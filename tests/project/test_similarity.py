@@ -7,12 +7,15 @@ rank first, the independent solutions must stay below the display
 threshold, and the stub's own text must never make a pair.
 """
 
+import base64
 import dataclasses
+import importlib.util
 import re
 import shutil
 import subprocess
 import sys
 import textwrap
+import unicodedata
 
 import pytest
 from _helpers import SUBPROCESS_BACKSTOP
@@ -72,16 +75,20 @@ return lam, vt.T
 """
 
 
+def pca_source(body):
+    """The stub ``pca.py`` with ``pca``'s body replaced by ``body``."""
+    stub = (REPO_ROOT / "pcl_course" / "pca.py").read_text()
+    assert stub.count(STUB_BODY) == 1
+    header = "import math\n\nimport numpy as np\n\n" if "math." in body else "import numpy as np\n\n"
+    return header + stub.replace(STUB_BODY, textwrap.indent(textwrap.dedent(body).strip() + "\n", "    "))
+
+
 def student(root, name, body=None):
     """A student's clone: the stubs, with ``pca``'s body written when given."""
     package = root / name / "pcl_course"
     shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
     if body is not None:
-        stub = (package / "pca.py").read_text()
-        assert stub.count(STUB_BODY) == 1
-        header = "import math\n\nimport numpy as np\n\n" if "math." in body else "import numpy as np\n\n"
-        source = header + stub.replace(STUB_BODY, textwrap.indent(textwrap.dedent(body).strip() + "\n", "    "))
-        (package / "pca.py").write_text(source)
+        (package / "pca.py").write_text(pca_source(body))
     return package
 
 
@@ -173,3 +180,56 @@ def test_the_report_fits_1280_px_and_counts_in_english(planted_class, tmp_path):
         )
         browser.close()
     assert overflow <= 0 and right <= 1280, (overflow, right)
+
+
+def utf7_every_character(text):
+    """``text`` in UTF-7, every character of each line base64-encoded (UTF-7 allows it; Python's codec does not)."""
+    runs = (base64.b64encode(line.encode("utf-16-be")).decode().rstrip("=") for line in text.split("\n"))
+    return "\n".join(f"+{run}-" if run else "" for run in runs).encode("ascii")
+
+
+def test_every_layout_graded_is_compared_as_python_decodes_it_and_every_entry_left_out_is_listed(tmp_path):
+    """A UTF-7 copy, a nested folder, loose files: compared; the rest listed with why."""
+    student(tmp_path, "alice", ALICE)  # a whole clone
+    # bob's clone: alice's file and one comment, in UTF-7 (every character base64-encoded) after a coding line
+    bob = student(tmp_path, "bob") / "pca.py"
+    bob.write_bytes(b"# -*- coding: utf-7 -*-\n" + utf7_every_character("# my own work\n" + pca_source(ALICE)))
+    assert importlib.util.decode_source(bob.read_bytes()).endswith(pca_source(ALICE))  # what Python runs
+    nested = tmp_path / "carol" / "work" / "2027"  # a nested folder, as Gradescope and batch find it
+    nested.mkdir(parents=True)
+    shutil.copytree(REPO_ROOT / "pcl_course", nested / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
+    (nested / "pcl_course" / "pca.py").write_text(pca_source(CAROL))
+    dave = tmp_path / "dave"  # carol's file, loose at the top
+    dave.mkdir()
+    (dave / "pca.py").write_text(pca_source(CAROL))
+    student(tmp_path, "henry", DAVE)  # independent
+    erin = tmp_path / "erin"  # Latin-1 bytes without a coding line: Python refuses to import it
+    erin.mkdir()
+    (erin / "pca.py").write_bytes(("# caf\u00e9\n" + pca_source(DAVE)).encode("latin-1"))
+    (tmp_path / "frank.txt").write_text("not a submission")
+    (tmp_path / "gina").mkdir()  # an empty upload
+    ivan = student(tmp_path, "ivan")  # pca written as a package: its __init__.py only is compared
+    (ivan / "pca.py").rename(ivan / "pca_init.py")
+    (ivan / "pca").mkdir()
+    (ivan / "pca_init.py").rename(ivan / "pca" / "__init__.py")
+    pairs, skipped = compare_class(tmp_path)
+    similarity = {(p.module, p.first, p.second): p.similarity for p in pairs}
+    found = {pair: similarity.get(("pca", *pair), 0) for pair in [("alice", "bob"), ("carol", "dave")]}
+    assert min(found.values()) > 0.9, (found, similarity, skipped)
+    copies = {("alice", "bob"), ("carol", "dave")}
+    assert all(s < DISPLAY_THRESHOLD for key, s in similarity.items() if key[1:] not in copies), similarity
+    assert len(skipped) == 4, skipped
+    assert skipped[0].startswith("erin: pca.py not compared: its bytes cannot be decoded as Python decodes them")
+    assert skipped[1] == "frank.txt: not compared: not a folder (a link or a file)"
+    assert skipped[2].startswith("gina: not compared: no pcl_course/ folder and none of pca.py")
+    assert skipped[3] == "ivan: pca/ is a package: only its __init__.py compared"
+
+
+def test_the_report_shows_students_control_characters_escaped():
+    from grading.instructors.similarity import Pair, render_report
+
+    code = ("x = 1  # \u202e}\u2066", "x = 1\x1b[8m")  # a Trojan-source comment; an escape sequence
+    hostile = Pair("pca", "esc\x1b]0;owned\x07", "bidi\u202egnp", 1.0, 1.0, 40, *code)
+    page = render_report([hostile], ["name\x1b[2J: not compared: not a folder"], threshold=0)
+    assert not [c for c in page if c not in "\n" and unicodedata.category(c) in ("Cc", "Cf", "Cs", "Zl", "Zp")]
+    assert "esc\\x1b]0;owned\\x07" in page and "bidi\\u202egnp" in page and "\\u202e}\\u2066" in page
