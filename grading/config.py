@@ -72,8 +72,8 @@ MAX_FEEDBACK_LINES = 12  # of one failed test's feedback
 DIAGNOSIS_MAX_VALUES = 2_000_000
 # Bytes of the copies (arguments and answers) kept for the diagnosis over a whole grading
 # (grading/diagnosis.py, Recorder): calls past it are recorded without them. The
-# reference's gradings keep REFERENCE_KEPT at most (measured, see the README).
-DIAGNOSIS_BUDGET = 256 * 1024**2
+# reference's whole grading (both lectures) keeps 21 MB (measured, see the README).
+DIAGNOSIS_BUDGET = 64 * 1024**2
 # Wall-clock seconds of one submission's whole grading: tests not started by
 # then score 0 with a line that says so (a test under way may add its own
 # TEST_TIMEOUT), within Gradescope's default limit of 10 minutes.
@@ -99,6 +99,7 @@ HEADER_LIMIT = 1024**2  # bytes of one answer's JSON header
 MAX_ARRAYS = 4096  # arrays (and modified arguments) in one answer
 MAX_TEXT = 2000  # characters kept of any one text a submission produced (a message, a name, a place)
 MAX_OUTPUT = 4000  # characters of one test's feedback (grading/results.py)
+MAX_REPORT = 64 * 1024  # characters of a failed test's traceback that pytest keeps until the session ends
 MAX_OUTPUT_LINES = MAX_FEEDBACK_LINES + 2  # lines of it: the message's, a diagnosis and the last call
 STDERR_TAIL_BYTES = 64 * 1024  # of the worker's stderr, read from its end after a crash
 
