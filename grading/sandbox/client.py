@@ -48,6 +48,7 @@ from grading.sandbox.processes import (
     process_table,
     reap,
     stat_of,
+    ticks_since_boot,
     usage_of,
 )
 from grading.sandbox.walls import BUBBLEWRAP, WRITABLE_ROOTS, isolation, remove_files_of
@@ -419,7 +420,11 @@ class CallUsage:
         self.seen = {}  # pid -> (start time, CPU seconds with reaped children, parent)
         self.gone = 0.0  # CPU seconds of processes gone that no process of the call reaped
         rows = [(pid, None, False) for pid in pids] if pids is not None else worker._call_processes()
-        self.start = self._read(rows, memory=False)[0]
+        # A process first seen later but started before this call (a zombie an earlier call
+        # left: the living ones are all in ``pids``) brings its earlier time into the baseline.
+        self.since = ticks_since_boot() - 1
+        self.start = 0.0
+        self.start = self._read(rows, memory=False)[0]  # everything they used so far
         self.polls = 0
 
     def _read(self, rows, memory=True):
@@ -431,6 +436,8 @@ class CallUsage:
                 continue
             start, own, reaped, threads, resident = usage
             current[pid] = (start, own + reaped, parent)
+            if self.seen.get(pid, (None,))[0] != start and start < self.since:
+                self.start += own + reaped  # not this call's
             cpu, used, tasks = cpu + own + reaped, used + resident, tasks + threads
         for pid, (start, total, parent) in self.seen.items():
             if current.get(pid, (None,))[0] == start:

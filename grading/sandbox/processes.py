@@ -234,5 +234,10 @@ def usage_of(pid, memory=True):
     return int(fields[19]), own, reaped, int(fields[17]), resident
 
 
+def ticks_since_boot():
+    """Now, in the unit and from the origin of a process's start time (/proc/PID/stat's field 22)."""
+    return time.clock_gettime(time.CLOCK_BOOTTIME) * _CLOCK_TICKS
+
+
 _PSS = re.compile(rb"^Pss:\s+(\d+) kB", re.MULTILINE)
 _PAGE_SIZE = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096

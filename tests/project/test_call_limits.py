@@ -75,6 +75,19 @@ CHILDREN = textwrap.dedent(
         time.sleep(rest)
         return "survived"
 
+    def many_children(count, seconds):
+        for _ in range(count):
+            if os.fork() == 0:
+                time.sleep(seconds)
+                os._exit(0)
+        time.sleep(seconds)
+        return "survived"
+
+    def burn_then_rest(seconds, rest):
+        burn(seconds)
+        time.sleep(rest)
+        return "survived"
+
     def burn_in_threads_and_return():
         burn(0.3)
         return "fine"
@@ -170,6 +183,24 @@ def test_cpu_time_of_orphans_counts_for_the_call(make_worker, monkeypatch):
         worker.call("children", "burn_in_orphans", (2, 1.2, 2.0), {})
 
 
+def test_zombies_an_earlier_call_left_are_not_charged_to_the_next_call(make_worker, monkeypatch):
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(timeout=2)
+    assert worker.call("children", "burn_in_unreaped_children", (2, 0.7, 0.0), {}) == "survived"
+    # 1.4 s in the zombies, 0.8 s in this call: over 2 s only if the zombies counted twice.
+    assert worker.call("children", "burn_then_rest", (0.8, 1.0), {}) == "survived"
+
+
+def test_a_call_running_more_processes_than_its_limit_is_stopped(make_worker, monkeypatch):
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker()
+    assert worker.call("children", "burn_in_threads_and_return", (), {}) == "fine"
+    # Set after the worker started: its RLIMIT_NPROC (a uid's) stays, the call's own count is checked.
+    monkeypatch.setattr(config, "PROCESS_LIMIT", 12)
+    with pytest.raises(SandboxError, match=r"more than 12 processes and threads"):
+        worker.call("children", "many_children", (20, 3.0), {})
+
+
 def test_a_call_under_its_cpu_limit_with_children_is_not_stopped(make_worker, monkeypatch):
     monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
     worker = make_worker(timeout=3)
@@ -244,3 +275,51 @@ def test_what_a_grading_keeps_for_the_diagnosis_is_bounded_as_a_whole(tmp_path, 
     assert kept <= 8 * 2**20
     assert calls[0].kept and not calls[-1].kept  # the first calls are kept, the later ones recorded without copies
     assert all(c.result is None and c.args == () for c in calls if not c.kept)
+
+
+PEAK_PLUGIN = """
+def pytest_unconfigure(config):
+    with open(PEAK, "w") as handle:
+        handle.write(next(line for line in open("/proc/self/status") if line.startswith("VmHWM:")))
+"""
+
+
+def test_a_whole_lecture_1_grading_answering_large_arrays_stays_under_1_gib(tmp_path):
+    """The grading process itself (VmHWM), every call of every lecture-1 function answering
+    just under DIAGNOSIS_MAX_VALUES values: 6.9 GiB when every such answer was kept."""
+    import json
+    import shutil
+    import subprocess
+    import sys
+
+    from _helpers import SUBPROCESS_BACKSTOP, load_results
+
+    from grading import REPO_ROOT
+
+    clone = tmp_path / "clone"
+    shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
+    functions = config.ASSIGNMENTS["lecture1"]
+    for function, module in functions.items():
+        with open(clone / "pcl_course" / f"{module}.py", "a") as handle:
+            handle.write(
+                f"\n\ndef {function}(*args, **kwargs):\n    import numpy as np\n"
+                f"    return np.zeros({config.DIAGNOSIS_MAX_VALUES - 1})\n"
+            )
+    peak = tmp_path / "peak.txt"
+    (tmp_path / "peak_plugin.py").write_text(PEAK_PLUGIN.replace("PEAK", repr(str(peak))))
+    options, results = tmp_path / "options.json", tmp_path / "results.json"
+    options.write_text(json.dumps({"impl": str(clone / "pcl_course"), "results": str(results)}))
+    command = [
+        sys.executable, "-m", "pytest", str(REPO_ROOT / "tests" / "graded"), str(REPO_ROOT / "tests" / "hidden"),
+        "-c", str(REPO_ROOT / "grading" / "pytest.ini"), "--rootdir", str(REPO_ROOT),
+        "-p", "pytest_timeout", "-p", "grading.plugin", "-p", "peak_plugin", "-p", "no:cacheprovider",
+        "-q", "--tb=no", "--sandbox", "--grading-options", str(options),
+        *[argument for function in functions for argument in ("--function", function)],
+    ]  # fmt: skip
+    env = dict(os.environ, PYTHONPATH=str(tmp_path), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
+    subprocess.run(command, cwd=REPO_ROOT, env=env, capture_output=True, timeout=SUBPROCESS_BACKSTOP)
+    summary = load_results(results)
+    assert len(summary["tests"]) > 100 and not any("too large" in t["text"] for t in summary["tests"])
+    peak_mib = int(peak.read_text().split()[1]) / 1024
+    print(f"the grading process peaked at {peak_mib:.0f} MiB")
+    assert peak_mib < 1024, f"the grading process peaked at {peak_mib:.0f} MiB"
