@@ -6,7 +6,6 @@ any folder with the same module files. It is imported as a private package
 this repository stay what the tests use.
 """
 
-import copy
 import importlib.util
 import itertools
 import os

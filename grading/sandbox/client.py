@@ -320,6 +320,7 @@ class Worker:
                 raise SandboxError(
                     f"timed out: the call waited for more than {deadline.wall_seconds:g} s (wall clock)", kind=TIMEOUT
                 )
+            deadline.usage.check_disk()  # at most every DISK_POLL_SECONDS, calls short or long
             ready, _, _ = select.select([stream], [], [], min(remaining, CPU_POLL_SECONDS))
             if ready:
                 return stream
@@ -425,7 +426,6 @@ class CallUsage:
         self.since = ticks_since_boot() - 1
         self.start = 0.0
         self.start = self._read(rows, memory=False)[0]  # everything they used so far
-        self.polls = 0
 
     def _read(self, rows, memory=True):
         """(CPU seconds so far, bytes of memory now, tasks now) of the processes ``rows``."""
@@ -451,7 +451,6 @@ class CallUsage:
         """Stop the call (kill its processes, raise a :class:`SandboxError`) if it is over a limit."""
         rows = self.worker._call_processes()
         cpu, used, tasks = self._read(rows)
-        self.polls += 1
         why = None
         if cpu - self.start > cpu_limit:
             why = f"timed out: the call used more than {cpu_limit:g} s of CPU time", TIMEOUT
@@ -459,18 +458,37 @@ class CallUsage:
             why = f"the call used more than {_size(config.CALL_MEMORY_LIMIT)} of memory across its processes", DIED
         elif tasks > config.PROCESS_LIMIT:
             why = f"the call ran more than {config.PROCESS_LIMIT} processes and threads at once", DIED
-        elif self.worker.uid is not None and self.worker.isolation.level != BUBBLEWRAP and self.polls % 4 == 1:
-            written = disk_usage_of(self.worker.uid, (*WRITABLE_ROOTS, self.worker.work))
-            if written > config.DISK_LIMIT:
-                why = f"the submission wrote more than {_size(config.DISK_LIMIT)} of files", DIED
-        if why is None:
+        if why is not None:
+            self._stop(rows, *why)
+
+    def check_disk(self):
+        """As a dedicated uid without bubblewrap (whose tmpfs are capped): stop the call if the
+        files the uid owns where it can write exceed :data:`config.DISK_LIMIT`. Read at most every
+        :data:`DISK_POLL_SECONDS` (a walk of those folders), whether the calls are long or short."""
+        uid = self.worker.uid
+        if uid is None or self.worker.isolation.level == BUBBLEWRAP:
             return
+        now = time.monotonic()
+        if now - _DISK_CHECKED.get(uid, 0.0) < DISK_POLL_SECONDS:
+            return
+        written = disk_usage_of(uid, (*WRITABLE_ROOTS, self.worker.work))
+        _DISK_CHECKED[uid] = time.monotonic()
+        if written > config.DISK_LIMIT:
+            message = f"the submission wrote more than {_size(config.DISK_LIMIT)} of files"
+            self._stop(self.worker._call_processes(), message, DIED)
+
+    def _stop(self, rows, message, kind):
+        """Kill the call's processes ``rows`` and raise the verdict."""
         for pid, _, _ in rows:  # at once, before anything else runs: the worker is stopped after
             try:
                 os.kill(pid, signal.SIGKILL)
             except OSError:
                 pass
-        raise SandboxError(why[0], kind=why[1])
+        raise SandboxError(message, kind=kind)
+
+
+DISK_POLL_SECONDS = 0.25  # how often the files of a dedicated uid are summed, at most
+_DISK_CHECKED = {}  # uid -> when its files were last summed (time.monotonic)
 
 
 def _size(count):

@@ -97,7 +97,7 @@ CHILDREN = textwrap.dedent(
         block = b"x" * 2**20
         for folder in folders:
             for i in range(count):
-                path = os.path.join(folder, f"fill-{os.getpid()}-{i}")
+                path = os.path.join(folder, f"fill-{os.getpid()}-{time.time_ns()}-{i}")
                 try:
                     with open(path, "wb") as handle:
                         for _ in range(mib):
@@ -236,6 +236,16 @@ def test_the_files_a_dedicated_uid_writes_are_bounded_for_the_worker(make_worker
     worker = make_worker()
     with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
         worker.call("children", "write_files", (["/tmp", "/dev/shm"], 8, 4, 3.0), {})
+
+
+@needs_uid_mode
+def test_short_calls_of_a_dedicated_uid_cannot_add_up_files_past_the_limit(make_worker, monkeypatch):
+    # No call lasts long enough for a reading of its own: the files are summed every 0.25 s anyway.
+    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
+    worker = make_worker()
+    with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
+        for _ in range(40):
+            worker.call("children", "write_files", (["/tmp"], 4, 1, 0.05), {})
 
 
 # -- the grader's own memory: what a grading keeps for the diagnosis ---------------------------
