@@ -70,6 +70,10 @@ MAX_FEEDBACK_LINES = 12  # of one failed test's feedback
 # Values (array entries) of one call's arguments kept for the diagnosis
 # (grading/diagnosis.py); larger calls are recorded without their arguments.
 DIAGNOSIS_MAX_VALUES = 2_000_000
+# Bytes of the copies (arguments and answers) kept for the diagnosis over a whole grading
+# (grading/diagnosis.py, Recorder): calls past it are recorded without them. The
+# reference's whole grading (both lectures) keeps 21 MB (measured, see the README).
+DIAGNOSIS_BUDGET = 64 * 1024**2
 # Wall-clock seconds of one submission's whole grading: tests not started by
 # then score 0 with a line that says so (a test under way may add its own
 # TEST_TIMEOUT), within Gradescope's default limit of 10 minutes.
@@ -81,6 +85,13 @@ CPU_LIMIT = 600  # CPU seconds for a worker's whole life
 PROCESS_LIMIT = 256  # processes of the sandbox user (fork bombs)
 FILE_SIZE_LIMIT = 256 * 1024**2  # bytes of any one file the worker writes
 TMP_SIZE = 256 * 1024**2  # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
+SHM_SIZE = 64 * 1024**2  # bytes of its private /dev/shm (tmpfs, bubblewrap only): the only other writable place
+# Limits of one call as a whole, over every process it started (alive, zombie or orphaned),
+# read while it runs (grading/sandbox/client.py, CallUsage); the CPU limit is CALL_TIMEOUT.
+CALL_MEMORY_LIMIT = MEMORY_LIMIT  # bytes of memory of all its processes together (their Pss)
+# Bytes of the files a dedicated sandbox uid may own in the places it can write (its home,
+# /tmp, /dev/shm, ...): the uid mode's counterpart of bubblewrap's TMP_SIZE + SHM_SIZE.
+DISK_LIMIT = TMP_SIZE + SHM_SIZE
 # What the grader reads from a worker, every size checked before anything is allocated
 # (grading/sandbox/): the grader's own memory stays bounded whatever a worker sends.
 ANSWER_LIMIT = 16 * 1024**2  # bytes of all the arrays of one answer (the reference's largest: 95 kB)
@@ -88,6 +99,7 @@ HEADER_LIMIT = 1024**2  # bytes of one answer's JSON header
 MAX_ARRAYS = 4096  # arrays (and modified arguments) in one answer
 MAX_TEXT = 2000  # characters kept of any one text a submission produced (a message, a name, a place)
 MAX_OUTPUT = 4000  # characters of one test's feedback (grading/results.py)
+MAX_REPORT = 64 * 1024  # characters of a failed test's traceback that pytest keeps until the session ends
 MAX_OUTPUT_LINES = MAX_FEEDBACK_LINES + 2  # lines of it: the message's, a diagnosis and the last call
 STDERR_TAIL_BYTES = 64 * 1024  # of the worker's stderr, read from its end after a crash
 

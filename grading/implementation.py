@@ -6,7 +6,6 @@ any folder with the same module files. It is imported as a private package
 this repository stay what the tests use.
 """
 
-import copy
 import importlib.util
 import itertools
 import os
@@ -17,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
-from grading.diagnosis import Call, contract_signature, size_of, snapshot
+from grading.diagnosis import Call, Recorder, contract_signature
 from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
 from grading.forbidden import read_source, scan_package
 
@@ -139,6 +138,7 @@ class Implementation:
         self.sandboxed = sandbox
         self.current_test = None  # set by the plugin: the test under way
         self.calls = {}  # graded function -> [Call], for the diagnosis
+        self.recorder = Recorder()  # what the calls keep, within one budget for the whole grading
         self.worker = None
         self.staged = None
         self.refusal = None
@@ -219,8 +219,8 @@ class Implementation:
         def graded_call(*args, **kwargs):
             self.last_call = describe_call(name, args, kwargs)
             self.last_modified, modified = [], []
-            kept = snapshot(args, kwargs)
-            call = Call(self.current_test, *(kept or ((), {})), kept=kept is not None)
+            kept = self.recorder.snapshot(args, kwargs)
+            call = Call(self.current_test, *(kept[0] if kept else ((), {})), kept=kept is not None)
             self.calls.setdefault(name, []).append(call)
             try:
                 result, modified = function(*args, **kwargs)
@@ -236,9 +236,12 @@ class Implementation:
             finally:
                 self.last_modified = argument_names(name, modified)
                 call.modified = bool(self.last_modified)
-            if kept is not None and size_of(result) <= config.DIAGNOSIS_MAX_VALUES:
-                call.result = copy.deepcopy(result)
-            else:  # too large to keep: the call is not replayed by the diagnosis
+            fits, copied = self.recorder.keep_result(result) if kept is not None else (False, None)
+            if fits:
+                call.result = copied
+            else:  # too large to keep, or past the grading's budget: the call is not replayed by the diagnosis
+                if kept is not None:
+                    self.recorder.release(kept[1])
                 call.kept, call.args, call.kwargs = False, (), {}
             return result
 

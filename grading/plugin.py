@@ -306,6 +306,12 @@ def pytest_runtest_makereport(item, call):
         outcomes[item.nodeid].interface = item.get_closest_marker("interface") is not None
         if failure.one_line:
             report.longrepr = result.feedback  # one line, not a traceback
+        else:
+            # pytest keeps every report until the session ends: a traceback quoting a huge
+            # answer (an f-string of answer.tolist()) would stay, test after test, in the grader.
+            text = str(report.longrepr)
+            if len(text) > grading_config.MAX_REPORT:
+                report.longrepr = f"{text[: grading_config.MAX_REPORT]}\n... ({len(text):,} characters, cut)"
     elif report.skipped and report.when != "teardown":
         reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else "skipped"
         reason = reason.removeprefix("Skipped: ")

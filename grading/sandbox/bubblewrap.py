@@ -5,8 +5,9 @@ interpreter (``sys.base_prefix``), the system libraries and the
 environment's site-packages, with every forbidden package and every
 editable-install file masked (:func:`masked_paths`, also what the uid level
 bars with ACLs); the staged submission, the worker script and its wire
-protocol; a size-capped tmpfs for ``/tmp`` (also ``HOME``), the only
-writable place; its own ``/proc`` and a minimal ``/dev``. No repository,
+protocol; a size-capped tmpfs for ``/tmp`` (also ``HOME``) and a smaller one for
+``/dev/shm``, the only writable places (the masks and ``/dev`` itself are
+read-only); its own ``/proc`` and a minimal ``/dev``. No repository,
 ``.git``, tests, solutions, ``grading/`` or other submission exists there.
 """
 
@@ -154,7 +155,7 @@ def _environment_binds(extra=()):
         source_root, target_root = next((s, t) for s, t in roots if s in entry.parents)
         target = f"{target_root}/{entry.relative_to(source_root)}"
         if entry.is_dir() and not entry.is_symlink():
-            options += ["--tmpfs", target]
+            options += ["--tmpfs", target, "--remount-ro", target]  # an empty folder, never a place to write
         else:
             options += ["--ro-bind", "/dev/null", target]
     return tuple(options)
@@ -192,6 +193,14 @@ def bubblewrap_command(staged_root, python_argv_tail, extra=()):
         "--proc",
         "/proc",
         "--dev",
+        "/dev",
+        # POSIX shared memory (multiprocessing's locks) in a capped tmpfs of its own, and
+        # nothing else of /dev writable: the devices are bound in, the folder read-only.
+        "--size",
+        str(config.SHM_SIZE),
+        "--tmpfs",
+        "/dev/shm",
+        "--remount-ro",
         "/dev",
         "--size",
         str(config.TMP_SIZE),

@@ -20,6 +20,7 @@ import os
 import select
 import shutil
 import signal
+import stat
 import subprocess
 import tempfile
 import time
@@ -39,8 +40,18 @@ from grading.sandbox.bubblewrap import (
     site_packages,
     spawn,
 )
-from grading.sandbox.processes import become_subreaper, kill_uid, living_processes, preexec, reap, stat_of
-from grading.sandbox.walls import BUBBLEWRAP, isolation, remove_files_of
+from grading.sandbox.processes import (
+    become_subreaper,
+    kill_uid,
+    living_processes,
+    preexec,
+    process_table,
+    reap,
+    stat_of,
+    ticks_since_boot,
+    usage_of,
+)
+from grading.sandbox.walls import BUBBLEWRAP, WRITABLE_ROOTS, isolation, remove_files_of
 
 
 class Worker:
@@ -171,19 +182,33 @@ class Worker:
         return False
 
     def _pids(self):
-        """The worker's processes: those of its uid, else its process and descendants."""
-        processes = living_processes()
+        """The worker's living processes: those of its uid, else its process, its descendants and
+        the rest of its session (:meth:`_call_processes`)."""
+        return [pid for pid, _, zombie in self._call_processes() if not zombie]
+
+    def _call_processes(self):
+        """(pid, parent, zombie) of every process a call of this worker started, zombies included.
+
+        With a dedicated uid, every process of that uid. Without one, the
+        worker's process, its descendants, and every process of its session
+        (the worker is a session leader): an orphan is re-parented to the
+        grader, a child subreaper, not to the worker. Bubblewrap's pid
+        namespace keeps its orphans under its own init, a descendant.
+        """
+        table = process_table()
         if self.uid is not None:
-            return [p[0] for p in processes if p[3] == self.uid]
+            return [(pid, parent, zombie) for pid, parent, _, uid, zombie in table if uid == self.uid]
+        root = self.process.pid
         children = {}
-        for pid, parent, _, _ in processes:
-            children.setdefault(parent, []).append(pid)
-        found, stack = [], [self.process.pid]
+        for row in table:
+            children.setdefault(row[1], []).append(row)
+        found, stack = {}, [row for row in table if row[0] == root or row[2] == root]
         while stack:
-            pid = stack.pop()
-            found.append(pid)
-            stack.extend(children.get(pid, ()))
-        return found
+            pid, parent, _, _, zombie = stack.pop()
+            if pid not in found:
+                found[pid] = (pid, parent, zombie)
+                stack.extend(children.get(pid, ()))
+        return list(found.values())
 
     def _tasks(self):
         """How many threads the worker runs, over all its processes (remembered for :meth:`cpu_seconds`)."""
@@ -345,13 +370,11 @@ class Worker:
                 raise SandboxError(
                     f"timed out: the call waited for more than {deadline.wall_seconds:g} s (wall clock)", kind=TIMEOUT
                 )
+            deadline.usage.check_disk()  # at most every DISK_POLL_SECONDS, calls short or long
             ready, _, _ = select.select([stream], [], [], min(remaining, CPU_POLL_SECONDS))
             if ready:
                 return stream
-            if self.cpu_seconds() - deadline.cpu_start > deadline.cpu_seconds:
-                raise SandboxError(
-                    f"timed out: the call used more than {deadline.cpu_seconds:g} s of CPU time", kind=TIMEOUT
-                )
+            deadline.usage.check(deadline.cpu_seconds)  # every process of the call, together
 
     def _read_exactly(self, size, deadline):
         """``size`` bytes of the worker's stdout, into a buffer allocated once (``size`` is checked already)."""
@@ -413,7 +436,7 @@ def _unwrapped(read, *args):
 
 @dataclass
 class _Deadline:
-    """A call's limits: CPU seconds of the worker from now, and a wall-clock backstop."""
+    """A call's limits: CPU seconds of the call's processes from now, and a wall-clock backstop."""
 
     worker: Worker
     cpu_seconds: float
@@ -421,9 +444,135 @@ class _Deadline:
     def __post_init__(self):
         # Between calls the worker runs exactly the processes counted after the last one (any more
         # would have stopped it): no need to walk /proc again here, the hot path of every call.
-        self.cpu_start = self.worker.cpu_seconds(self.worker.known_pids)
+        self.usage = CallUsage(self.worker, self.worker.known_pids)
+        self.cpu_start = self.usage.start
         self.wall_seconds = self.cpu_seconds * config.CALL_WALL_FACTOR
         self.wall = time.monotonic() + self.wall_seconds
+
+
+class CallUsage:
+    """What one call's processes use together: CPU seconds, memory, tasks and, as a dedicated
+    uid, disk; read while the call runs (every :data:`CPU_POLL_SECONDS`), the call stopped,
+    every process of it killed, as soon as one is over its limit.
+
+    The limits of :func:`grading.sandbox.processes.preexec` hold for each
+    process; these hold for the call as a whole, however many processes it
+    starts. The call's processes are :meth:`Worker._call_processes`'s:
+    zombies count (they keep the CPU time they used until reaped), and a
+    process gone since the last reading keeps the CPU time it had then,
+    unless its parent, a process of the call, reaped it (that time then
+    shows in the parent's reaped children's time). Memory is the sum of
+    every living process's proportional share of what it maps (``Pss``):
+    shared pages are counted once.
+    """
+
+    def __init__(self, worker, pids=None):
+        self.worker = worker
+        self.seen = {}  # pid -> (start time, CPU seconds with reaped children, parent)
+        self.gone = 0.0  # CPU seconds of processes gone that no process of the call reaped
+        rows = [(pid, None, False) for pid in pids] if pids is not None else worker._call_processes()
+        # A process first seen later but started before this call (a zombie an earlier call
+        # left: the living ones are all in ``pids``) brings its earlier time into the baseline.
+        self.since = ticks_since_boot() - 1
+        self.start = 0.0
+        self.start = self._read(rows, memory=False)[0]  # everything they used so far
+
+    def _read(self, rows, memory=True):
+        """(CPU seconds so far, bytes of memory now, tasks now) of the processes ``rows``."""
+        cpu, used, tasks, current = 0.0, 0, 0, {}
+        for pid, parent, _ in rows:
+            usage = usage_of(pid, memory)
+            if usage is None:
+                continue
+            start, own, reaped, threads, resident = usage
+            current[pid] = (start, own + reaped, parent)
+            if self.seen.get(pid, (None,))[0] != start and start < self.since:
+                self.start += own + reaped  # not this call's
+            cpu, used, tasks = cpu + own + reaped, used + resident, tasks + threads
+        for pid, (start, total, parent) in self.seen.items():
+            if current.get(pid, (None,))[0] == start:
+                continue
+            if parent not in current:  # reaped by no process of the call: its time would be lost
+                self.gone += total
+        self.seen = current
+        return cpu + self.gone, used, tasks
+
+    def check(self, cpu_limit):
+        """Stop the call (kill its processes, raise a :class:`SandboxError`) if it is over a limit."""
+        rows = self.worker._call_processes()
+        cpu, used, tasks = self._read(rows)
+        why = None
+        if cpu - self.start > cpu_limit:
+            why = f"timed out: the call used more than {cpu_limit:g} s of CPU time", TIMEOUT
+        elif used > config.CALL_MEMORY_LIMIT:
+            why = f"the call used more than {_size(config.CALL_MEMORY_LIMIT)} of memory across its processes", DIED
+        elif tasks > config.PROCESS_LIMIT:
+            why = f"the call ran more than {config.PROCESS_LIMIT} processes and threads at once", DIED
+        if why is not None:
+            self._stop(rows, *why)
+
+    def check_disk(self):
+        """As a dedicated uid without bubblewrap (whose tmpfs are capped): stop the call if the
+        files the uid owns where it can write exceed :data:`config.DISK_LIMIT`. Read at most every
+        :data:`DISK_POLL_SECONDS` (a walk of those folders), whether the calls are long or short."""
+        uid = self.worker.uid
+        if uid is None or self.worker.isolation.level == BUBBLEWRAP:
+            return
+        now = time.monotonic()
+        if now - _DISK_CHECKED.get(uid, 0.0) < DISK_POLL_SECONDS:
+            return
+        written = disk_usage_of(uid, (*WRITABLE_ROOTS, self.worker.work))
+        _DISK_CHECKED[uid] = time.monotonic()
+        if written > config.DISK_LIMIT:
+            message = f"the submission wrote more than {_size(config.DISK_LIMIT)} of files"
+            self._stop(self.worker._call_processes(), message, DIED)
+
+    def _stop(self, rows, message, kind):
+        """Kill the call's processes ``rows`` and raise the verdict."""
+        for pid, _, _ in rows:  # at once, before anything else runs: the worker is stopped after
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+        raise SandboxError(message, kind=kind)
+
+
+DISK_POLL_SECONDS = 0.25  # how often the files of a dedicated uid are summed, at most
+_DISK_CHECKED = {}  # uid -> when its files were last summed (time.monotonic)
+
+
+def _size(count):
+    """A byte count as people write it (4 GiB, 256 MiB)."""
+    for unit, size in (("GiB", 1024**3), ("MiB", 1024**2), ("KiB", 1024)):
+        if count >= size:
+            return f"{count / size:g} {unit}"
+    return f"{count} bytes"
+
+
+def disk_usage_of(uid, roots):
+    """Bytes of the files ``uid`` owns below ``roots`` (allocated blocks: a sparse file counts what it holds).
+
+    As :func:`grading.sandbox.walls.remove_files_of` finds them: a dedicated
+    uid creates entries only in world-writable folders (recursed into) and
+    in its own folders (recursed into too). Links are never followed.
+    """
+    total, stack = 0, [root for root in roots if root]
+    while stack:
+        folder = stack.pop()
+        try:
+            entries = list(os.scandir(folder))
+        except OSError:
+            continue
+        for entry in entries:
+            try:
+                info = entry.stat(follow_symlinks=False)
+            except OSError:
+                continue
+            if info.st_uid == uid:
+                total += info.st_blocks * 512
+            if stat.S_ISDIR(info.st_mode) and (info.st_uid == uid or info.st_mode & stat.S_IWOTH):
+                stack.append(entry.path)
+    return total
 
 
 def _arrays(value, path):

@@ -1,0 +1,335 @@
+"""Limits of a call as a whole, and of a grading as a whole (issue 35, class 4).
+
+The resource limits of a worker (``RLIMIT_AS``, ``RLIMIT_CPU``, ...) hold
+for each of its processes; these tests check the limits that hold for a
+call over every process it starts (alive, zombie or orphaned), for what a
+sandbox can write, and for what the grader itself keeps of the calls for
+the diagnosis. The limits are made small here (a call of 2 CPU seconds, a
+few hundred MiB of memory) so that the tests stay fast; they count CPU
+time, not the wall clock, so that a busy machine changes no verdict.
+"""
+
+import os
+import textwrap
+
+import numpy as np
+import pytest
+
+from grading import config
+from grading.errors import SandboxError
+from grading.sandbox import Worker, isolation
+from grading.staging import stage
+
+CHILDREN = textwrap.dedent(
+    """
+    import os, time
+    import numpy as np
+
+    def burn(seconds):
+        start = time.process_time()
+        while time.process_time() - start < seconds:
+            pass
+
+    def hold_memory_in_children(count, mib, seconds):
+        # Each child holds its own pages (written, so resident); together they hold count * mib.
+        done = []
+        for _ in range(count):
+            ready, told = os.pipe()
+            if os.fork() == 0:
+                block = np.ones(mib * 2**20 // 8)
+                os.write(told, b"x")
+                time.sleep(seconds)
+                os._exit(0)
+            done.append(ready)
+        for ready in done:
+            os.read(ready, 1)
+        time.sleep(seconds)
+        return "survived"
+
+    def burn_in_unreaped_children(count, seconds, rest):
+        # One child at a time burns `seconds` of CPU and exits; none is ever reaped (zombies).
+        for _ in range(count):
+            ready, told = os.pipe()
+            if os.fork() == 0:
+                burn(seconds)
+                os.write(told, b"x")
+                os._exit(0)
+            os.read(ready, 1)
+        time.sleep(rest)
+        return "survived"
+
+    def burn_in_orphans(count, seconds, rest):
+        # A child forks a grandchild and exits (reaped here): the grandchild, an orphan
+        # re-parented away from the worker, burns `seconds` of CPU and exits.
+        for _ in range(count):
+            ready, told = os.pipe()
+            child = os.fork()
+            if child == 0:
+                if os.fork() == 0:
+                    burn(seconds)
+                    os.write(told, b"x")
+                    os._exit(0)
+                os._exit(0)
+            os.waitpid(child, 0)
+            os.read(ready, 1)
+        time.sleep(rest)
+        return "survived"
+
+    def many_children(count, seconds):
+        for _ in range(count):
+            if os.fork() == 0:
+                time.sleep(seconds)
+                os._exit(0)
+        time.sleep(seconds)
+        return "survived"
+
+    def burn_then_rest(seconds, rest):
+        burn(seconds)
+        time.sleep(rest)
+        return "survived"
+
+    def burn_in_threads_and_return():
+        burn(0.3)
+        return "fine"
+
+    def write_files(folders, mib, count, rest):
+        written = []
+        block = b"x" * 2**20
+        for folder in folders:
+            for i in range(count):
+                path = os.path.join(folder, f"fill-{os.getpid()}-{time.time_ns()}-{i}")
+                try:
+                    with open(path, "wb") as handle:
+                        for _ in range(mib):
+                            handle.write(block)
+                    written.append(path)
+                except OSError:
+                    break
+        time.sleep(rest)
+        return written
+
+    def writable_places():
+        # Every mount of the sandbox where a file can be created, with its size (statvfs).
+        found, seen = {}, set()
+        for line in open("/proc/self/mountinfo"):
+            point = line.split()[4]
+            if point.startswith("/proc") or point in seen or not os.path.isdir(point):
+                continue
+            seen.add(point)
+            path = os.path.join(point, ".probe")
+            try:
+                with open(path, "wb") as handle:
+                    handle.write(b"x")
+                os.remove(path)
+            except OSError:
+                continue
+            info = os.statvfs(point)
+            found[point] = info.f_blocks * info.f_frsize
+        return found
+    """
+)
+
+
+@pytest.fixture
+def make_worker(tmp_path):
+    workers = []
+
+    def make(timeout=10):
+        package = tmp_path / "clone" / "pcl_course"
+        if not package.exists():
+            package.mkdir(parents=True)
+            (package / "__init__.py").write_text("")
+            (package / "children.py").write_text(CHILDREN)
+        worker = Worker(stage(package).root, timeout=timeout)
+        workers.append(worker)
+        return worker
+
+    yield make
+    for worker in workers:
+        worker.close()
+
+
+def test_children_holding_memory_together_over_the_call_limit_are_stopped(make_worker, monkeypatch):
+    # Three children of 160 MiB each: every one is far below the per-process limit, together
+    # they are over the call's (set to 320 MiB here; 4 GiB when grading).
+    monkeypatch.setattr(config, "CALL_MEMORY_LIMIT", 320 * 2**20, raising=False)
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker()
+    with pytest.raises(SandboxError, match=r"more than 320 MiB of memory across its processes"):
+        worker.call("children", "hold_memory_in_children", (3, 160, 3.0), {})
+    assert worker.call("children", "burn_in_threads_and_return", (), {}) == "fine"  # a fresh worker
+
+
+def test_children_under_the_memory_limit_together_are_not_stopped(make_worker, monkeypatch):
+    monkeypatch.setattr(config, "CALL_MEMORY_LIMIT", 320 * 2**20, raising=False)
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker()
+    assert worker.call("children", "hold_memory_in_children", (3, 40, 1.0), {}) == "survived"
+
+
+def test_cpu_time_of_children_never_reaped_counts_for_the_call(make_worker, monkeypatch):
+    # Two children of 1.2 CPU seconds each, one after the other, never reaped: no reading ever
+    # sees more than 1.2 s in a living process, but the call used 2.4 s of its 2.
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(timeout=2)
+    with pytest.raises(SandboxError, match=r"more than 2 s of CPU time"):
+        worker.call("children", "burn_in_unreaped_children", (2, 1.2, 2.0), {})
+
+
+def test_cpu_time_of_orphans_counts_for_the_call(make_worker, monkeypatch):
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(timeout=2)
+    with pytest.raises(SandboxError, match=r"more than 2 s of CPU time"):
+        worker.call("children", "burn_in_orphans", (2, 1.2, 2.0), {})
+
+
+def test_zombies_an_earlier_call_left_are_not_charged_to_the_next_call(make_worker, monkeypatch):
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(timeout=2)
+    assert worker.call("children", "burn_in_unreaped_children", (2, 0.7, 0.0), {}) == "survived"
+    # 1.4 s in the zombies, 0.8 s in this call: over 2 s only if the zombies counted twice.
+    assert worker.call("children", "burn_then_rest", (0.8, 1.0), {}) == "survived"
+
+
+def test_a_call_running_more_processes_than_its_limit_is_stopped(make_worker, monkeypatch):
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker()
+    assert worker.call("children", "burn_in_threads_and_return", (), {}) == "fine"
+    # Set after the worker started: its RLIMIT_NPROC (a uid's) stays, the call's own count is checked.
+    monkeypatch.setattr(config, "PROCESS_LIMIT", 12)
+    with pytest.raises(SandboxError, match=r"more than 12 processes and threads"):
+        worker.call("children", "many_children", (20, 3.0), {})
+
+
+def test_a_call_under_its_cpu_limit_with_children_is_not_stopped(make_worker, monkeypatch):
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(timeout=3)
+    assert worker.call("children", "burn_in_unreaped_children", (2, 0.5, 1.0), {}) == "survived"
+
+
+needs_bubblewrap = pytest.mark.skipif(isolation().level != "bubblewrap", reason="needs bubblewrap")
+needs_uid_mode = pytest.mark.skipif(isolation().level != "uid", reason="needs the uid mode (root, no namespaces)")
+
+
+@needs_bubblewrap
+def test_nothing_is_writable_in_bubblewrap_but_the_capped_tmp_and_shm(make_worker):
+    places = make_worker().call("children", "writable_places", (), {})
+    assert set(places) == {"/tmp", "/dev/shm"}, places
+    assert places["/tmp"] <= config.TMP_SIZE and places["/dev/shm"] <= config.SHM_SIZE
+
+
+@needs_bubblewrap
+def test_writing_to_shm_and_the_masks_in_bubblewrap_fails_past_the_cap(make_worker):
+    worker = make_worker()
+    masks = [f"/sandbox/site-packages/{name}" for name in ("sklearn", "open3d")]
+    written = worker.call("children", "write_files", (["/dev/shm", "/dev", *masks], 16, 8, 0.0), {})
+    outside_shm = [path for path in written if not path.startswith("/dev/shm/")]
+    assert not outside_shm, written
+    assert len(written) * 16 * 2**20 <= config.SHM_SIZE, f"{len(written)} files of 16 MiB in /dev/shm"
+
+
+@needs_uid_mode
+def test_the_files_a_dedicated_uid_writes_are_bounded_for_the_worker(make_worker, monkeypatch):
+    # Each file is under RLIMIT_FSIZE; together they are over the uid's disk limit (32 MiB here).
+    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker()
+    with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
+        worker.call("children", "write_files", (["/tmp", "/dev/shm"], 8, 4, 3.0), {})
+
+
+@needs_uid_mode
+def test_short_calls_of_a_dedicated_uid_cannot_add_up_files_past_the_limit(make_worker, monkeypatch):
+    # No call lasts long enough for a reading of its own: the files are summed every 0.25 s anyway.
+    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
+    worker = make_worker()
+    with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
+        for _ in range(40):
+            worker.call("children", "write_files", (["/tmp"], 4, 1, 0.05), {})
+
+
+# -- the grader's own memory: what a grading keeps for the diagnosis ---------------------------
+
+
+LARGE_ANSWERS = textwrap.dedent(
+    """
+    import numpy as np
+
+    def pca(points):
+        return np.zeros(100_000), np.zeros((3, 3))  # 800 kB a call, under DIAGNOSIS_MAX_VALUES
+    """
+)
+
+
+def test_what_a_grading_keeps_for_the_diagnosis_is_bounded_as_a_whole(tmp_path, monkeypatch):
+    from grading.implementation import Implementation
+
+    def nbytes(value):  # of the arrays a kept copy holds
+        if isinstance(value, np.ndarray):
+            return value.nbytes
+        if isinstance(value, (tuple, list)):
+            return sum(nbytes(v) for v in value)
+        return sum(nbytes(v) for v in value.values()) if isinstance(value, dict) else 0
+
+    monkeypatch.setattr(config, "DIAGNOSIS_BUDGET", 8 * 2**20, raising=False)
+    package = tmp_path / "pcl_course"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "pca.py").write_text(LARGE_ANSWERS)
+    impl = Implementation(package)
+    points = np.random.default_rng(0).normal(size=(200, 3))
+    for _ in range(40):  # 32 MB of answers in all
+        impl.pca(points)
+    calls = impl.calls["pca"]
+    kept = sum(nbytes(c.args) + nbytes(c.kwargs) + nbytes(c.result) for c in calls if c.kept)
+    assert kept <= 8 * 2**20
+    assert calls[0].kept and not calls[-1].kept  # the first calls are kept, the later ones recorded without copies
+    assert all(c.result is None and c.args == () for c in calls if not c.kept)
+
+
+PEAK_PLUGIN = """
+def pytest_unconfigure(config):
+    with open(PEAK, "w") as handle:
+        handle.write(next(line for line in open("/proc/self/status") if line.startswith("VmHWM:")))
+"""
+
+
+def test_a_whole_lecture_1_grading_answering_large_arrays_stays_under_1_gib(tmp_path):
+    """The grading process itself (VmHWM), every call of every lecture-1 function answering
+    just under DIAGNOSIS_MAX_VALUES values: 6.9 GiB when every such answer was kept."""
+    import json
+    import shutil
+    import subprocess
+    import sys
+
+    from _helpers import SUBPROCESS_BACKSTOP, load_results
+
+    from grading import REPO_ROOT
+
+    clone = tmp_path / "clone"
+    shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
+    functions = config.ASSIGNMENTS["lecture1"]
+    for function, module in functions.items():
+        with open(clone / "pcl_course" / f"{module}.py", "a") as handle:
+            handle.write(
+                f"\n\ndef {function}(*args, **kwargs):\n    import numpy as np\n"
+                f"    return np.zeros({config.DIAGNOSIS_MAX_VALUES - 1})\n"
+            )
+    peak = tmp_path / "peak.txt"
+    (tmp_path / "peak_plugin.py").write_text(PEAK_PLUGIN.replace("PEAK", repr(str(peak))))
+    options, results = tmp_path / "options.json", tmp_path / "results.json"
+    options.write_text(json.dumps({"impl": str(clone / "pcl_course"), "results": str(results)}))
+    command = [
+        sys.executable, "-m", "pytest", str(REPO_ROOT / "tests" / "graded"), str(REPO_ROOT / "tests" / "hidden"),
+        "-c", str(REPO_ROOT / "grading" / "pytest.ini"), "--rootdir", str(REPO_ROOT),
+        "-p", "pytest_timeout", "-p", "grading.plugin", "-p", "peak_plugin", "-p", "no:cacheprovider",
+        "-q", "--tb=no", "--sandbox", "--grading-options", str(options),
+        *[argument for function in functions for argument in ("--function", function)],
+    ]  # fmt: skip
+    env = dict(os.environ, PYTHONPATH=str(tmp_path), PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
+    subprocess.run(command, cwd=REPO_ROOT, env=env, capture_output=True, timeout=SUBPROCESS_BACKSTOP)
+    summary = load_results(results)
+    assert len(summary["tests"]) > 100 and not any("too large" in t["text"] for t in summary["tests"])
+    peak_mib = int(peak.read_text().split()[1]) / 1024
+    print(f"the grading process peaked at {peak_mib:.0f} MiB")
+    assert peak_mib < 1024, f"the grading process peaked at {peak_mib:.0f} MiB"
