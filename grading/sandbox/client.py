@@ -374,6 +374,10 @@ class Worker:
             ready, _, _ = select.select([stream], [], [], min(remaining, CPU_POLL_SECONDS))
             if ready:
                 return stream
+            if self.process.poll() is not None:
+                # A dead worker answers nothing: whatever still holds its pipe open (a daemon it
+                # forked, outside any namespace) is a leftover, never waited for.
+                raise SandboxError(self._death_message(), kind=DIED)
             deadline.usage.check(deadline.cpu_seconds)  # every process of the call, together
 
     def _read_exactly(self, size, deadline):
