@@ -31,6 +31,8 @@ __all__ = [
     "kdtree_reach",
     "octree_reach",
     "decoy_points",
+    "leaf_walk",
+    "trap_swaps",
     "brute_knn",
     "brute_radius",
 ]
@@ -420,3 +422,193 @@ def _leaves(tree):
     if "axis" in tree:
         return [int(i) for i in np.flatnonzero(tree["axis"] < 0)]
     return [int(i) for i in np.flatnonzero(np.all(tree["children"] < 0, axis=1))]
+
+
+# -- traps: swaps between leaves every lawful search reads ----------------------------------------
+
+
+def leaf_walk(tree, query):
+    """The leaves in the rule's depth-first order, with their cells and the cubes above them.
+
+    The order is the contract's: the child on the query's side first (k-d
+    tree: left if ``q[a] <= split``; octree: the query's own code, then the
+    others in code order). A leaf's cell is its claimed geometry: the k-d
+    tree's box from its ancestors' splits (infinite outside the root), the
+    octree's cube ``center +- extent``.
+
+    Parameters
+    ----------
+    tree : dict
+        A k-d tree or an octree.
+    query : ndarray, shape (D,)
+
+    Returns
+    -------
+    list of (int, ndarray, ndarray, list of int)
+        ``(leaf, lower, upper, path)`` in walk order; ``path`` holds the
+        nodes from the root to the leaf, both included.
+    """
+    query = np.asarray(query, dtype=float)
+    walk = []
+    if "axis" in tree:
+        dim = len(query)
+        stack = [(0, np.full(dim, -math.inf), np.full(dim, math.inf), [0])]
+        while stack:
+            node, lower, upper, path = stack.pop()
+            if tree["axis"][node] < 0:
+                walk.append((node, lower, upper, path))
+                continue
+            a, s = tree["axis"][node], tree["split"][node]
+            left_upper, right_lower = upper.copy(), lower.copy()
+            left_upper[a], right_lower[a] = min(upper[a], s), max(lower[a], s)
+            left = (int(tree["left"][node]), lower, left_upper, path + [int(tree["left"][node])])
+            right = (int(tree["right"][node]), right_lower, upper, path + [int(tree["right"][node])])
+            stack += [right, left] if query[a] <= s else [left, right]  # the near child is popped first
+        return walk
+    query = query[:3]
+    stack = [(0, [0])]
+    while stack:
+        node, path = stack.pop()
+        center, extent = tree["center"][node], tree["extent"][node]
+        if is_octree_leaf(tree, node):
+            walk.append((node, center - extent, center + extent, path))
+            continue
+        own = sum(1 << j for j in range(3) if query[j] > center[j])
+        codes = [own] + [c for c in range(8) if c != own]
+        for code in reversed(codes):
+            child = int(tree["children"][node, code])
+            if child >= 0:
+                stack.append((child, path + [child]))
+    return walk
+
+
+def _box_gap_squared(lower, upper, query):
+    return float(np.sum((np.maximum(lower - query, 0.0) + np.maximum(query - upper, 0.0)) ** 2))
+
+
+def _strictly_inside(point, lower, upper):
+    return bool(np.all((point > lower) & (point < upper)))
+
+
+def _contained_on_path(tree, path, query, radius):
+    """Whether the octree radius search's contains test is true (or near) at a node of ``path``."""
+    for node in path:
+        reach2 = float(np.sum((np.abs(query - tree["center"][node]) + tree["extent"][node]) ** 2))
+        if reach2 <= radius**2 * (1 + TRAP_MARGIN):
+            return True
+    return False
+
+
+# Traps keep this relative distance from every decision they rely on (a cell's distance against the
+# k-th distance or the radius, a point's distance against the k-th distance).
+TRAP_MARGIN = 1e-6
+
+
+def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
+    """``tree`` with points swapped between leaves that every lawful search reads.
+
+    A trap takes a point p that is in the answer and a point u, each strictly
+    inside the cell of its leaf, B and A, and exchanges their places in
+    ``order``: the tree now lists p under A and u under B, each outside the
+    cell of the leaf that lists it. The points themselves do not move.
+
+    Radius search: A and B are any two leaves within ``radius`` of the query
+    (cell distance), neither the query's own leaf nor, in an octree, under a
+    node that the ball contains; p is a point of A within the radius, u any
+    point of B. kNN: A and B lie within the k-th distance, A comes before B
+    in the rule's depth-first order and is strictly nearer (cell distance),
+    p is an answer point of B and u a point of A beyond the k-th distance
+    (the module docstring proves why every lawful search still answers
+    right). Each pair uses leaves of its own; the first pair is searched
+    among leaves other than the query's own one.
+
+    Parameters
+    ----------
+    tree : dict
+        A k-d tree or an octree of ``points``, true to its points.
+    points : ndarray, shape (N, D)
+    query : ndarray, shape (D,)
+    k : int, optional
+    radius : float, optional
+        Exactly one of ``k`` and ``radius``.
+    pairs : int, default 2
+        At most this many swaps.
+
+    Returns
+    -------
+    lying : dict
+        A copy of ``tree`` with the swaps in ``order``.
+    swapped : ndarray of int64, shape (2 * n_pairs,)
+        The swapped points' indices, p then u for each pair.
+    own_leaf_kept : bool
+        Whether some swap leaves both of its leaves apart from the query's
+        own leaf (a search that filters all but its own leaf fails it).
+    """
+    points = np.asarray(points, dtype=float)
+    octree = "axis" not in tree
+    xyz = points[:, :3] if octree else points
+    query = np.asarray(query, dtype=float)[: xyz.shape[1]]
+    s = squared_distances(xyz, query)
+    if k is not None:
+        answer = np.lexsort((np.arange(len(s)), s))[:k]
+        bound2 = float(s[answer[-1]])
+    else:
+        answer = np.flatnonzero(s <= radius**2)
+        bound2 = radius**2
+    in_answer = np.zeros(len(s), dtype=bool)
+    in_answer[answer] = True
+    walk = leaf_walk(tree, query)
+    own = {leaf for leaf, lower, upper, _ in walk if _box_gap_squared(lower, upper, query) == 0.0}
+    necessary = []  # (walk position, leaf, lower, upper, gap2, positions in order)
+    for position, (leaf, lower, upper, path) in enumerate(walk):
+        gap2 = _box_gap_squared(lower, upper, query)
+        if gap2 > bound2 * (1 - TRAP_MARGIN):
+            continue
+        if radius is not None and octree and _contained_on_path(tree, path, query, radius):
+            continue
+        slots = [
+            p for p in range(tree["start"][leaf], tree["stop"][leaf]) if _strictly_inside(xyz[tree["order"][p]], lower, upper)
+        ]
+        necessary.append((position, leaf, gap2, slots))
+    order = np.array(tree["order"], dtype=np.int64)
+    used, swapped, apart = set(), [], False
+    for attempt in range(2 * pairs):
+        if len(swapped) == 2 * pairs:
+            break
+        avoid_own = attempt == 0 or radius is not None
+        found = _trap_pair(necessary, order, s, in_answer, bound2, k, used | (own if avoid_own else set()))
+        if found is None:
+            continue
+        (a_leaf, a_slot), (b_leaf, b_slot) = found
+        used |= {a_leaf, b_leaf}
+        apart = apart or not ({a_leaf, b_leaf} & own)
+        swapped += [int(order[b_slot if k is not None else a_slot]), int(order[a_slot if k is not None else b_slot])]
+        order[a_slot], order[b_slot] = order[b_slot], order[a_slot]
+    lying = {key: np.array(value, copy=True) for key, value in tree.items()}
+    lying["order"] = order
+    return lying, np.array(swapped, dtype=np.int64), apart
+
+
+def _trap_pair(necessary, order, s, in_answer, bound2, k, excluded):
+    """Two slots ``(leaf, position in order)`` to swap: see :func:`trap_swaps`; None if there are none."""
+    leaves = [entry for entry in necessary if entry[1] not in excluded]
+    if k is None:  # radius: p of A within the radius, u of B anywhere
+        for _, a_leaf, _, a_slots in leaves:
+            inner = [p for p in a_slots if s[order[p]] <= bound2 * (1 - TRAP_MARGIN)]
+            if not inner:
+                continue
+            for _, b_leaf, _, b_slots in leaves:
+                if b_leaf != a_leaf and b_slots:
+                    return (a_leaf, inner[0]), (b_leaf, b_slots[0])
+        return None
+    for a_position, a_leaf, a_gap2, a_slots in leaves:  # kNN: u of A beyond the k-th distance
+        far = [p for p in a_slots if not in_answer[order[p]] and s[order[p]] >= bound2 * (1 + TRAP_MARGIN)]
+        if not far:
+            continue
+        for b_position, b_leaf, b_gap2, b_slots in leaves:
+            if b_position <= a_position or a_gap2 >= b_gap2 * (1 - TRAP_MARGIN):
+                continue
+            near = [p for p in b_slots if in_answer[order[p]]]
+            if near:
+                return (a_leaf, far[0]), (b_leaf, near[0])
+    return None
