@@ -502,6 +502,9 @@ def _contained_on_path(tree, path, query, radius):
 # Traps keep this relative distance from every decision they rely on (a cell's distance against the
 # k-th distance or the radius, a point's distance against the k-th distance).
 TRAP_MARGIN = 1e-6
+# A swapped point lies at least this far outside the cell that now lists it, relative to the k-th
+# distance or the radius (the pair farthest out is chosen).
+SWAP_CLEARANCE = 1e-3
 
 
 def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
@@ -559,7 +562,7 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
     in_answer[answer] = True
     walk = leaf_walk(tree, query)
     own = {leaf for leaf, lower, upper, _ in walk if _box_gap_squared(lower, upper, query) == 0.0}
-    necessary = []  # (walk position, leaf, lower, upper, gap2, positions in order)
+    necessary = []  # (walk position, leaf, gap2, lower, upper, positions in order of its points inside it)
     for position, (leaf, lower, upper, path) in enumerate(walk):
         gap2 = _box_gap_squared(lower, upper, query)
         if gap2 > bound2 * (1 - TRAP_MARGIN):
@@ -567,16 +570,18 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
         if radius is not None and octree and _contained_on_path(tree, path, query, radius):
             continue
         slots = [
-            p for p in range(tree["start"][leaf], tree["stop"][leaf]) if _strictly_inside(xyz[tree["order"][p]], lower, upper)
+            p
+            for p in range(tree["start"][leaf], tree["stop"][leaf])
+            if _strictly_inside(xyz[tree["order"][p]], lower, upper)
         ]
-        necessary.append((position, leaf, gap2, slots))
+        necessary.append((position, leaf, gap2, lower, upper, slots))
     order = np.array(tree["order"], dtype=np.int64)
     used, swapped, apart = set(), [], False
     for attempt in range(2 * pairs):
         if len(swapped) == 2 * pairs:
             break
         avoid_own = attempt == 0 or radius is not None
-        found = _trap_pair(necessary, order, s, in_answer, bound2, k, used | (own if avoid_own else set()))
+        found = _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, used | (own if avoid_own else set()))
         if found is None:
             continue
         (a_leaf, a_slot), (b_leaf, b_slot) = found
@@ -589,26 +594,34 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
     return lying, np.array(swapped, dtype=np.int64), apart
 
 
-def _trap_pair(necessary, order, s, in_answer, bound2, k, excluded):
-    """Two slots ``(leaf, position in order)`` to swap: see :func:`trap_swaps`; None if there are none."""
+def _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, excluded):
+    """Two slots ``(leaf, position in order)`` to swap (see :func:`trap_swaps`), or None if there are none.
+
+    Of the pairs that qualify, the one whose two points end farthest outside
+    their new cells, so that a filter with a tolerance drops them too.
+    """
     leaves = [entry for entry in necessary if entry[1] not in excluded]
-    if k is None:  # radius: p of A within the radius, u of B anywhere
-        for _, a_leaf, _, a_slots in leaves:
-            inner = [p for p in a_slots if s[order[p]] <= bound2 * (1 - TRAP_MARGIN)]
-            if not inner:
+    best, best_score = None, SWAP_CLEARANCE * math.sqrt(bound2)
+    for a_position, a_leaf, a_gap2, a_lower, a_upper, a_slots in leaves:
+        if k is None:  # radius: p of A within the radius
+            a_points = [p for p in a_slots if s[order[p]] <= bound2 * (1 - TRAP_MARGIN)]
+        else:  # kNN: u of A beyond the k-th distance
+            a_points = [p for p in a_slots if not in_answer[order[p]] and s[order[p]] >= bound2 * (1 + TRAP_MARGIN)]
+        for b_position, b_leaf, b_gap2, b_lower, b_upper, b_slots in leaves:
+            if b_leaf == a_leaf:
                 continue
-            for _, b_leaf, _, b_slots in leaves:
-                if b_leaf != a_leaf and b_slots:
-                    return (a_leaf, inner[0]), (b_leaf, b_slots[0])
-        return None
-    for a_position, a_leaf, a_gap2, a_slots in leaves:  # kNN: u of A beyond the k-th distance
-        far = [p for p in a_slots if not in_answer[order[p]] and s[order[p]] >= bound2 * (1 + TRAP_MARGIN)]
-        if not far:
-            continue
-        for b_position, b_leaf, b_gap2, b_slots in leaves:
-            if b_position <= a_position or a_gap2 >= b_gap2 * (1 - TRAP_MARGIN):
+            if k is None:  # radius: u of B anywhere
+                b_points = b_slots
+            elif b_position <= a_position or a_gap2 >= b_gap2 * (1 - TRAP_MARGIN):
                 continue
-            near = [p for p in b_slots if in_answer[order[p]]]
-            if near:
-                return (a_leaf, far[0]), (b_leaf, near[0])
-    return None
+            else:  # kNN: p of B in the answer, A before B and nearer
+                b_points = [p for p in b_slots if in_answer[order[p]]]
+            for a_slot in a_points:
+                out_a = math.sqrt(_box_gap_squared(b_lower, b_upper, xyz[order[a_slot]]))
+                if out_a <= best_score:
+                    continue
+                for b_slot in b_points:
+                    score = min(out_a, math.sqrt(_box_gap_squared(a_lower, a_upper, xyz[order[b_slot]])))
+                    if score > best_score:
+                        best, best_score = ((a_leaf, a_slot), (b_leaf, b_slot)), score
+    return best

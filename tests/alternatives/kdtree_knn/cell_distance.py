@@ -28,7 +28,9 @@ def _search(tree, points, query, k):
             return
         a, s = tree["axis"][node], tree["split"][node]
         diff = query[a] - s
-        near, far = (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+        near, far = (
+            (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+        )
         visit(near, cell2, offsets)
         far_cell2 = cell2 - offsets[a] ** 2 + diff**2
         if far_cell2 <= worst():
