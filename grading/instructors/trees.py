@@ -1,5 +1,5 @@
 """The grader's own trees for lecture 2: canonical builds, the contract's searches with the
-nodes they reach, and the lying trees of the structure tests.
+nodes they reach, and the lying trees of the structure tests (decoys and traps).
 
 Written from the contract in ``pcl_course/nn.py``, independently of
 ``solutions/`` (plain Python and NumPy, slow and simple). The searches are
@@ -14,6 +14,44 @@ tree still says those points are where they were. A search that follows the
 rule, or prunes more, never reads them and returns the true answer; one that
 reads an unreached node (brute force, a library, no pruning, the far side
 first, a too-weak test) returns a decoy.
+
+**Traps** (:func:`trap_swaps`, :func:`bst_trap_swaps`): decoys alone do not
+catch a search that reads every leaf and drops the points lying outside
+their leaf's cell (every decoy does). So the same tree also swaps, in
+``order``, a point p of the answer with a point u, between two leaves A and
+B that every lawful search reads (lawful: the rule, or a search that prunes
+more with a test on a node's cell, in the rule's order or best-bin-first).
+The points do not move; p is listed under a leaf whose cell it lies outside,
+so the filter drops it and loses an answer point. Every lawful search still
+answers right:
+
+- Radius: the set read does not depend on the points. A leaf whose cell
+  lies within r of q is read by every lawful search (its pruning bound at an
+  ancestor is at most the leaf's cell distance), so A and B, both such
+  leaves, are read and each point is kept by its own distance. In an octree
+  neither A nor B lies under a node the ball contains (whose points are
+  reported untested).
+- kNN: A and B lie within the k-th distance d_k (so every lawful search
+  reads them: the held worst w never drops below d_k), A before B in the
+  rule's depth-first order and nearer in cell distance (so before it in
+  best-bin-first order too), p an answer point of B, u a point of A farther
+  than d_k. Compare a lawful search on the trapped tree with the same search
+  on the true tree. While the true search has read A but not B, the trapped
+  one holds p where the true one holds u, and p ranks before u; otherwise
+  both have read the same points. Swapping a held point for one that ranks
+  before it never raises the k-th held (s, index), so the trapped search's
+  w is at most the true one's at every step; every pruning test (plane,
+  cell, best-bin-first's stop, the octree's early termination) only prunes
+  more with a smaller w, so it reads a subset of what the true search reads
+  (and never a decoy), and what it skips is strictly beyond its w, so its
+  answer is the true one. The BST is the same argument with one key per
+  node: only the keys of childless nodes are swapped (a key elsewhere routes
+  the search), B's key nearer than A's.
+
+Margins keep every decision the traps rely on clear of ties (TRAP_MARGIN),
+and the swapped points lie well outside their new cells (SWAP_CLEARANCE), so
+that a filter with a tolerance drops them as well. What answers cannot show:
+a search that reads a node and makes no use of it.
 
 This module answers exercises, so it ships with the instructors' grader only
 (``grading/instructors/``), never in the student release.
@@ -33,6 +71,7 @@ __all__ = [
     "decoy_points",
     "leaf_walk",
     "trap_swaps",
+    "bst_trap_swaps",
     "brute_knn",
     "brute_radius",
 ]
@@ -625,3 +664,66 @@ def _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, excluded):
                     if score > best_score:
                         best, best_score = ((a_leaf, a_slot), (b_leaf, b_slot)), score
     return best
+
+
+def bst_trap_swaps(keys, left, right, query, k, pairs=2):
+    """``keys`` with the keys of childless nodes swapped where every lawful BST search reads both.
+
+    A BST's keys are its geometry too, so only the keys of nodes without
+    children can move without changing where a search goes. A pair is two
+    such nodes A and B whose intervals (from their ancestors' keys: ``[lo,
+    key)`` to the left, ``[key, hi]`` to the right) lie within the k-th
+    distance, A before B in the rule's depth-first order and strictly nearer;
+    B's key is among the k nearest and strictly nearer the query than A's
+    (which may be too: the keys are distinct, so the nearer key moving to
+    the leaf read first is all the argument of :func:`trap_swaps` needs).
+    After the swap node A holds B's key, outside A's interval: a search that
+    drops the keys outside their node's interval loses node A from its
+    answer.
+
+    Returns
+    -------
+    lying : ndarray, shape (N,)
+        The keys with the swaps (the expected answer is brute force on them).
+    swapped : ndarray of int64
+        The swapped node ids, A then B for each pair.
+    """
+    keys = np.asarray(keys, dtype=float)
+    gaps = np.abs(keys - query)
+    answer = np.lexsort((np.arange(len(keys)), gaps))[:k]
+    bound = float(gaps[answer[-1]])
+    in_answer = np.zeros(len(keys), dtype=bool)
+    in_answer[answer] = True
+    walk, stack = [], [(0, -math.inf, math.inf)]
+    while stack:  # depth first, the query's side first
+        node, lo, hi = stack.pop()
+        if left[node] < 0 and right[node] < 0:
+            gap = max(lo - query, query - hi, 0.0)
+            inside = lo < keys[node] < hi
+            if gap <= bound * (1 - TRAP_MARGIN) and inside:
+                walk.append((len(walk), int(node), gap, lo, hi))
+            continue
+        children = [(left[node], lo, keys[node]), (right[node], keys[node], hi)]
+        if query < keys[node]:
+            children.reverse()  # the left child is popped first
+        stack.extend((int(c), a, b) for c, a, b in children if c >= 0)
+    lying = keys.copy()
+    used, swapped = set(), []
+    for a_position, a, a_gap, a_lo, a_hi in walk:
+        if len(swapped) == 2 * pairs or a in used:
+            continue
+        for b_position, b, b_gap, b_lo, b_hi in walk:
+            if b in used or b_position <= a_position or not in_answer[b] or a_gap >= b_gap * (1 - TRAP_MARGIN):
+                continue
+            if gaps[a] <= gaps[b] * (1 + TRAP_MARGIN) + bound * TRAP_MARGIN:  # the nearer key moves earlier
+                continue
+            clearance = SWAP_CLEARANCE * bound
+            if not (keys[b] < a_lo - clearance or keys[b] > a_hi + clearance):
+                continue
+            if not (keys[a] < b_lo - clearance or keys[a] > b_hi + clearance):
+                continue
+            lying[a], lying[b] = keys[b], keys[a]
+            used |= {a, b}
+            swapped += [a, b]
+            break
+    return lying, np.array(swapped, dtype=np.int64)

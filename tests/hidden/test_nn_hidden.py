@@ -119,19 +119,23 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
     rng = np.random.default_rng(81)
     keys = rng.uniform(0, 1000, 2000)
     left, right = trees.bst(keys)
-    for k in (1, 5):
-        for query in rng.uniform(100, 900, 4):
+    traps = 0
+    for k, count in ((1, 4), (5, 4), (12, 12)):
+        for query in rng.uniform(100, 900, count):
             reached, margin = trees.bst_reach(keys, left, right, query, k)
             if margin < MARGIN:
                 continue
             nearest = np.sort(np.abs(keys - query))[0]
-            lying = keys.copy()
+            trapped_keys, trapped = trees.bst_trap_swaps(keys, left, right, query, k)
+            traps += len(trapped) // 2
+            lying = trapped_keys.copy()
             unreached = np.setdiff1d(np.arange(len(keys)), sorted(reached))
             lying[unreached] = query + nearest * 1e-3 * (1 + np.arange(len(unreached)) / len(unreached))
             indices, _ = impl.bst_knn(lying, left, right, float(query), k)
-            expected = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
+            expected = np.lexsort((np.arange(len(keys)), np.abs(trapped_keys - query)))[:k]
             if indices.tolist() != expected.tolist():
-                raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"))
+                raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"), expected, trapped)
+    assert traps >= 2, "the test needs traps on its queries"
 
 
 # -- k-d tree -------------------------------------------------------------------------------------

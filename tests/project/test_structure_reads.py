@@ -29,10 +29,10 @@ from grading.errors import CheckFailed
 from grading.instructors import tree_searches, trees
 from solutions import nn
 from tests.hidden import test_nn_hidden as hidden
-from tests.mutants import _cell_filter, _plain_trees
+from tests.mutants import _bst_filter, _cell_filter, _plain_trees
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-SEARCHES = ("kdtree_knn", "kdtree_radius", "octree_knn", "octree_radius")
+SEARCHES = ("bst_knn", "kdtree_knn", "kdtree_radius", "octree_knn", "octree_radius")
 
 
 def load(path, name):
@@ -79,9 +79,37 @@ def octree_best_bin_first(tree, points, queries, k):
     return indices, np.sqrt(np.array([[s for s, _ in row] for row in rows]).reshape(len(rows), k))
 
 
+def bst_interval_pruning(keys, left, right, query, k):
+    """Depth first, the query's side first, a subtree entered only if its interval is within the k-th distance.
+
+    The interval's distance is at least the rule's ``|key - query|``: it prunes more.
+    """
+    keys = np.asarray(keys, dtype=float)
+    held = []  # (distance, node), sorted
+
+    def worst():
+        return held[-1][0] if len(held) == k else np.inf
+
+    stack = [(0, -np.inf, np.inf)]
+    while stack:
+        node, lo, hi = stack.pop()
+        if max(lo - query, query - hi, 0.0) > worst():
+            continue
+        held = sorted([*held, (abs(keys[node] - query), node)])[:k]
+        children = [(right[node], keys[node], hi), (left[node], lo, keys[node])]  # the left child popped first
+        if query >= keys[node]:
+            children.reverse()
+        stack.extend((int(c), a, b) for c, a, b in children if c >= 0)
+    return np.array([i for _, i in held], dtype=np.int64), np.array([d for d, _ in held])
+
+
 def lawful(function):
     """Every correct search of ``function`` the project knows, by name."""
-    found = {"reference": getattr(nn, function), "grader's rule": grader_rule(function)}
+    if function == "bst_knn":
+        found = {"reference": nn.bst_knn, "grader's rule": lambda keys, *rest: tree_searches.bst_search(keys, *rest)}
+        found["interval pruning (this file)"] = bst_interval_pruning
+    else:
+        found = {"reference": getattr(nn, function), "grader's rule": grader_rule(function)}
     found["mutants' plain search"] = getattr(_plain_trees, function)
     for path in sorted((REPO_ROOT / "tests" / "alternatives" / function).glob("*.py")):
         found[f"alternative {path.stem}"] = load(path, function)
@@ -125,9 +153,22 @@ READS = "reads nodes its rule does not reach"
 DROPS = "drops points of nodes it must read"
 
 
+def bst_brute_force(keys, left, right, query, k):
+    gaps = np.abs(np.asarray(keys, dtype=float) - query)
+    rank = np.lexsort((np.arange(len(gaps)), gaps))[:k]
+    return rank, gaps[rank]
+
+
 def cheats(function):
     """Ways of reading what the rule does not reach, each with the rule its failure must state."""
     mutants = REPO_ROOT / "tests" / "mutants" / function
+    if function == "bst_knn":
+        return {
+            "brute force": (bst_brute_force, READS),
+            "mutant sorted_array": (load(mutants / "sorted_array.py", function), READS),
+            "mutant filters_by_interval": (load(mutants / "filters_by_interval.py", function), DROPS),
+            "filter (this file's import)": (_bst_filter.bst_knn, DROPS),
+        }
     return {
         "brute force": (brute_force(function), READS),
         "scipy cKDTree": (scipy_knn if function.endswith("knn") else scipy_radius, READS),
@@ -207,3 +248,21 @@ def test_on_a_trapped_tree_lawful_searches_read_within_their_reads_and_answer_ri
                 for name, search in radius_searches.items():
                     assert search(lying, points, query[None], radius)[1].tolist() == expected.tolist(), name
     assert planted >= 40 and apart >= 20, f"too few traps planted ({planted}, {apart} apart from the own leaf)"
+
+
+def test_on_trapped_bst_keys_lawful_searches_read_within_their_reads_and_answer_right(rng):
+    keys = rng.uniform(0, 1000, 1500)
+    left, right = trees.bst(keys)
+    searches = {name: search for name, search in lawful("bst_knn").items() if name != "reference"}
+    planted = 0
+    for query in rng.uniform(50, 950, 60):
+        k = int(rng.integers(2, 30))
+        lying, swapped = trees.bst_trap_swaps(keys, left, right, query, k)
+        planted += len(swapped) // 2
+        assert trees.bst_reach(lying, left, right, query, k)[0] <= trees.bst_reach(keys, left, right, query, k)[0]
+        expected = np.lexsort((np.arange(len(keys)), np.abs(lying - query)))[:k]
+        for name, search in searches.items():
+            assert search(lying, left, right, query, k)[0].tolist() == expected.tolist(), name
+        if len(swapped):
+            assert swapped[0] in expected and swapped[0] not in _bst_filter.bst_knn(lying, left, right, query, k)[0]
+    assert planted >= 10, f"too few traps planted ({planted})"

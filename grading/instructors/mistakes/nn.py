@@ -178,6 +178,21 @@ def bst_brute(keys, left, right, query, k):
     return rank.astype(np.int64), np.abs(keys[rank] - query)
 
 
+def bst_interval_filtered(keys, left, right, query, k):
+    """The interval-filter cheat: every node read, its key dropped if outside the node's interval (from its
+    ancestors' keys: below a key to the left, at or above it to the right), the k nearest of the rest."""
+    keys, left, right, query, k = _bst_case(keys, left, right, query, k)
+    kept, stack = [], [(0, -math.inf, math.inf)]
+    while stack:
+        node, lo, hi = stack.pop()
+        if lo <= keys[node] <= hi:
+            kept.append(node)
+        stack += [(int(c), a, b) for c, a, b in ((left[node], lo, keys[node]), (right[node], keys[node], hi)) if c >= 0]
+    kept = np.array(sorted(kept), dtype=np.int64)
+    rank = np.lexsort((kept, np.abs(keys[kept] - query)))[:k]
+    return kept[rank], np.abs(keys[kept[rank]] - query)
+
+
 BST_KNN = Model(
     truth=bst_knn,
     output_dtypes=("int64", "float64"),
@@ -189,6 +204,7 @@ BST_KNN = Model(
             "k-th distance with a lower index is missed",
             lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, strict=True),
         ),
+        Mistake("filters_by_cell", FILTERS_BY_CELL, bst_interval_filtered),
     ),
 )
 
