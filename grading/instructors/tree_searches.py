@@ -200,9 +200,9 @@ def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=Fa
 
     A point within a relative 1e-9 of its cell counts as inside (a cube
     ``c +- e`` in floating point can miss the cloud's extreme points by an
-    ulp). ``own_leaf=True`` spares the query's own leaf (the first of the walk when
-    its cell holds the query). On a true tree it answers right; on the
-    structure tests' lying trees it drops the decoys and the trapped points.
+    ulp). ``own_leaf=True`` spares the query's own leaf (:func:`_own_leaf`).
+    On a true tree it answers right; on the structure tests' lying trees it
+    drops the decoys and the trapped points.
     """
     points = np.asarray(points, dtype=float)
     width = points.shape[1] if "axis" in tree else 3
@@ -210,10 +210,11 @@ def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=Fa
     rows = []
     for query in np.asarray(queries, dtype=float).reshape(-1, np.asarray(queries).shape[-1])[:, :width]:
         walk = trees.leaf_walk(tree, query)
+        own = _own_leaf(tree, query) if own_leaf else None
         kept = []
-        for position, (leaf, lower, upper, _) in enumerate(walk):
+        for leaf, lower, upper, _ in walk:
             indices = tree["order"][tree["start"][leaf] : tree["stop"][leaf]]
-            spared = own_leaf and position == 0 and np.all((query >= lower) & (query <= upper))
+            spared = leaf == own
             slack = 1e-9 * (
                 1 + np.abs(np.nan_to_num(lower, posinf=0, neginf=0)) + np.abs(np.nan_to_num(upper, posinf=0, neginf=0))
             )
@@ -228,3 +229,18 @@ def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=Fa
             inside = s <= radius**2
             rows.append(list(zip(s[inside].tolist(), kept[inside].tolist())))
     return _knn_rows(rows, k) if k is not None else _csr_rows(rows)
+
+
+def _own_leaf(tree, query):
+    """The leaf the descent reaches by the query's side (k-d tree) or code (octree); None where a child is absent."""
+    node = 0
+    if "axis" in tree:
+        while tree["axis"][node] >= 0:
+            node = tree["left"][node] if query[tree["axis"][node]] <= tree["split"][node] else tree["right"][node]
+        return int(node)
+    while not is_octree_leaf(tree, node):
+        code = sum(1 << j for j in range(3) if query[j] > tree["center"][node][j])
+        node = tree["children"][node, code]
+        if node < 0:
+            return None
+    return int(node)
