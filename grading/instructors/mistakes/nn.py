@@ -180,17 +180,25 @@ def bst_brute(keys, left, right, query, k):
 
 def bst_interval_filtered(keys, left, right, query, k):
     """The interval-filter cheat: every node read, its key dropped if outside the node's interval (from its
-    ancestors' keys: below a key to the left, at or above it to the right), the k nearest of the rest."""
+    ancestors' keys: below a key to the left, at or above it to the right), the k nearest of the rest.
+
+    Two codings: a child's interval nested in its parent's (the parent's key clipped to it), or the parent's
+    key taken as is (they differ under a node whose key lies outside its own interval)."""
     keys, left, right, query, k = _bst_case(keys, left, right, query, k)
-    kept, stack = [], [(0, -math.inf, math.inf)]
-    while stack:
-        node, lo, hi = stack.pop()
-        if lo <= keys[node] <= hi:
-            kept.append(node)
-        stack += [(int(c), a, b) for c, a, b in ((left[node], lo, keys[node]), (right[node], keys[node], hi)) if c >= 0]
-    kept = np.array(sorted(kept), dtype=np.int64)
-    rank = np.lexsort((kept, np.abs(keys[kept] - query)))[:k]
-    return kept[rank], np.abs(keys[kept[rank]] - query)
+
+    def filtered(nested):
+        kept, stack = [], [(0, -math.inf, math.inf)]
+        while stack:
+            node, lo, hi = stack.pop()
+            if lo <= keys[node] <= hi:
+                kept.append(node)
+            below, above = (min(hi, keys[node]), max(lo, keys[node])) if nested else (keys[node], keys[node])
+            stack += [(int(c), a, b) for c, a, b in ((left[node], lo, below), (right[node], above, hi)) if c >= 0]
+        kept = np.array(sorted(kept), dtype=np.int64)
+        rank = np.lexsort((kept, np.abs(keys[kept] - query)))[:k]
+        return kept[rank], np.abs(keys[kept[rank]] - query)
+
+    return Variants(filtered(nested) for nested in (True, False))
 
 
 BST_KNN = Model(
