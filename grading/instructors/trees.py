@@ -552,7 +552,9 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
     A trap takes a point p that is in the answer and a point u, each strictly
     inside the cell of its leaf, B and A, and exchanges their places in
     ``order``: the tree now lists p under A and u under B, each outside the
-    cell of the leaf that lists it. The points themselves do not move.
+    cell of the leaf that lists it, first in that leaf's range (so that a
+    leaf scan that stops early, a fault of its own, does not lose them and
+    read as a filter). The points themselves do not move.
 
     Radius search: A and B are any two leaves within ``radius`` of the query
     (cell distance), neither the query's own leaf nor, in an octree, under a
@@ -628,6 +630,9 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
         apart = apart or not ({a_leaf, b_leaf} & own)
         swapped += [int(order[b_slot if k is not None else a_slot]), int(order[a_slot if k is not None else b_slot])]
         order[a_slot], order[b_slot] = order[b_slot], order[a_slot]
+        for leaf, slot in ((a_leaf, a_slot), (b_leaf, b_slot)):  # each newcomer first in its leaf
+            first = tree["start"][leaf]
+            order[first : slot + 1] = np.roll(order[first : slot + 1], 1)
     lying = {key: np.array(value, copy=True) for key, value in tree.items()}
     lying["order"] = order
     return lying, np.array(swapped, dtype=np.int64), apart

@@ -266,3 +266,17 @@ def test_on_trapped_bst_keys_lawful_searches_read_within_their_reads_and_answer_
         if len(swapped):
             assert swapped[0] in expected and swapped[0] not in _bst_filter.bst_knn(lying, left, right, query, k)[0]
     assert planted >= 10, f"too few traps planted ({planted})"
+
+
+LOSERS = [("octree_radius", "stops_at_a_miss"), ("kdtree_radius", "strict_keep"), ("octree_knn", "strict_overlap")]
+
+
+@pytest.mark.parametrize("function, mutant", LOSERS, ids=[f"{f}-{m}" for f, m in LOSERS])
+def test_a_search_that_loses_points_of_its_own_is_not_told_it_filters(function, mutant):
+    """A trapped point comes first in its new leaf: a scan that stops early keeps it, and a search that loses
+    points by its own fault reads "answers wrong", not the filter's line."""
+    search = load(REPO_ROOT / "tests" / "mutants" / function / f"{mutant}.py", function)
+    try:
+        structure_test(function)(types.SimpleNamespace(**{function: search}))
+    except CheckFailed as failed:
+        assert DROPS not in failed.rule, failed.rule
