@@ -466,7 +466,7 @@ def _leaves(tree):
 # -- traps: swaps between leaves every lawful search reads ----------------------------------------
 
 
-def leaf_walk(tree, query):
+def leaf_walk(tree, query, within=None):
     """The leaves in the rule's depth-first order, with their cells and the cubes above them.
 
     The order is the contract's: the child on the query's side first (k-d
@@ -480,6 +480,9 @@ def leaf_walk(tree, query):
     tree : dict
         A k-d tree or an octree.
     query : ndarray, shape (D,)
+    within : float, optional
+        Only the leaves whose cell's squared distance is at most this (the
+        subtrees beyond it are not walked).
 
     Returns
     -------
@@ -494,6 +497,8 @@ def leaf_walk(tree, query):
         stack = [(0, np.full(dim, -math.inf), np.full(dim, math.inf), [0])]
         while stack:
             node, lower, upper, path = stack.pop()
+            if within is not None and _box_gap_squared(lower, upper, query) > within:
+                continue
             if tree["axis"][node] < 0:
                 walk.append((node, lower, upper, path))
                 continue
@@ -509,6 +514,8 @@ def leaf_walk(tree, query):
     while stack:
         node, path = stack.pop()
         center, extent = tree["center"][node], tree["extent"][node]
+        if within is not None and _box_gap_squared(center - extent, center + extent, query) > within:
+            continue
         if is_octree_leaf(tree, node):
             walk.append((node, center - extent, center + extent, path))
             continue
@@ -601,7 +608,7 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
         bound2 = radius**2
     in_answer = np.zeros(len(s), dtype=bool)
     in_answer[answer] = True
-    walk = leaf_walk(tree, query)
+    walk = leaf_walk(tree, query, within=bound2)
     own = {leaf for leaf, lower, upper, _ in walk if _box_gap_squared(lower, upper, query) == 0.0}
     necessary = []  # (walk position, leaf, gap2, lower, upper, positions in order of its points inside it)
     for position, (leaf, lower, upper, path) in enumerate(walk):
