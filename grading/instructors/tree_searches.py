@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from grading.instructors import trees
 from grading.instructors.trees import Best, brute_knn, brute_radius, cell_gap_squared, is_octree_leaf, squared_distances
 
 
@@ -192,3 +193,54 @@ def bst_search(keys, left, right, query, k, strict=False):
         if far >= 0 and (gap < best.worst or (not strict and gap == best.worst)):
             stack.append((far, False))
     return np.array([i for _, i in best.held], dtype=np.int64), np.array([s for s, _ in best.held], dtype=float)
+
+
+def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=False):
+    """A known cheat: every leaf read, its points outside the leaf's (closed) cell dropped, brute force on the rest.
+
+    A point within a relative 1e-9 of its cell counts as inside (a cube
+    ``c +- e`` in floating point can miss the cloud's extreme points by an
+    ulp). ``own_leaf=True`` spares the query's own leaf (:func:`_own_leaf`).
+    On a true tree it answers right; on the structure tests' lying trees it
+    drops the decoys and the trapped points.
+    """
+    points = np.asarray(points, dtype=float)
+    width = points.shape[1] if "axis" in tree else 3
+    points = points[:, :width]
+    rows = []
+    for query in np.asarray(queries, dtype=float).reshape(-1, np.asarray(queries).shape[-1])[:, :width]:
+        walk = trees.leaf_walk(tree, query)
+        own = _own_leaf(tree, query) if own_leaf else None
+        kept = []
+        for leaf, lower, upper, _ in walk:
+            indices = tree["order"][tree["start"][leaf] : tree["stop"][leaf]]
+            spared = leaf == own
+            slack = 1e-9 * (
+                1 + np.abs(np.nan_to_num(lower, posinf=0, neginf=0)) + np.abs(np.nan_to_num(upper, posinf=0, neginf=0))
+            )
+            inside = np.all((points[indices] >= lower - slack) & (points[indices] <= upper + slack), axis=1)
+            kept.extend(indices.tolist() if spared else indices[inside].tolist())
+        kept = np.array(sorted(kept), dtype=np.int64)
+        s = squared_distances(points[kept], query)
+        if k is not None:
+            rank = np.lexsort((kept, s))[:k]
+            rows.append(list(zip(s[rank].tolist(), kept[rank].tolist())))
+        else:
+            inside = s <= radius**2
+            rows.append(list(zip(s[inside].tolist(), kept[inside].tolist())))
+    return _knn_rows(rows, k) if k is not None else _csr_rows(rows)
+
+
+def _own_leaf(tree, query):
+    """The leaf the descent reaches by the query's side (k-d tree) or code (octree); None where a child is absent."""
+    node = 0
+    if "axis" in tree:
+        while tree["axis"][node] >= 0:
+            node = tree["left"][node] if query[tree["axis"][node]] <= tree["split"][node] else tree["right"][node]
+        return int(node)
+    while not is_octree_leaf(tree, node):
+        code = sum(1 << j for j in range(3) if query[j] > tree["center"][node][j])
+        node = tree["children"][node, code]
+        if node < 0:
+            return None
+    return int(node)

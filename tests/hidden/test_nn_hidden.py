@@ -14,6 +14,13 @@ A search can also fail these tests by losing points where the rule reads
 (an exclusive test, a leaf scan that stops early): then its answer holds
 no planted point, and the failure says that it answers wrong there instead
 of blaming the structure.
+
+The same trees also hold traps (:func:`grading.instructors.trees.trap_swaps`):
+two points swapped in ``order`` between leaves that every lawful search
+reads, so that each is listed under a leaf whose cell it lies outside. A
+search that trusts the tree reads both leaves and answers right; one that
+reads every leaf and drops the points lying outside their leaf's cell (which
+drops every decoy too) loses an answer point, and is told so.
 """
 
 import numpy as np
@@ -49,10 +56,24 @@ def wrong_answer_failure(what):
     )
 
 
-def failure(what, answer, planted, planted_failure):
+def dropped_failure(what):
+    return CheckFailed(
+        f"{what}: your search dropped a point of a node it must read (it checks whether points lie in their "
+        "node's cell): the contract says to trust the tree",
+        rule=f"{what} drops points of nodes it must read (it checks them against their cells)",
+    )
+
+
+def failure(what, answer, planted, planted_failure, expected=(), trapped=()):
     """What a failed structure check shows: the planted failure when the answer holds a planted point
-    (the search read what it must not), else a wrong answer (the search lost points, a fault of its own)."""
-    return planted_failure if np.isin(answer, planted).any() else wrong_answer_failure(what)
+    (the search read what it must not); a dropped point when every point it misses is one the traps
+    listed outside its cell (it filtered the tree); else a wrong answer (it lost points, a fault of its own)."""
+    if np.isin(answer, planted).any():
+        return planted_failure
+    missing = np.setdiff1d(expected, answer)
+    if len(missing) and np.isin(missing, trapped).all():
+        return dropped_failure(what)
+    return wrong_answer_failure(what)
 
 
 def fair_queries(points, seed, reach, count=N_QUERIES):
@@ -98,19 +119,23 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
     rng = np.random.default_rng(81)
     keys = rng.uniform(0, 1000, 2000)
     left, right = trees.bst(keys)
-    for k in (1, 5):
-        for query in rng.uniform(100, 900, 4):
+    traps = 0
+    for k, count in ((1, 4), (5, 4), (12, 12)):
+        for query in rng.uniform(100, 900, count):
             reached, margin = trees.bst_reach(keys, left, right, query, k)
             if margin < MARGIN:
                 continue
             nearest = np.sort(np.abs(keys - query))[0]
-            lying = keys.copy()
+            trapped_keys, trapped = trees.bst_trap_swaps(keys, left, right, query, k)
+            traps += len(trapped) // 2
+            lying = trapped_keys.copy()
             unreached = np.setdiff1d(np.arange(len(keys)), sorted(reached))
             lying[unreached] = query + nearest * 1e-3 * (1 + np.arange(len(unreached)) / len(unreached))
             indices, _ = impl.bst_knn(lying, left, right, float(query), k)
-            expected = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
+            expected = np.lexsort((np.arange(len(keys)), np.abs(trapped_keys - query)))[:k]
             if indices.tolist() != expected.tolist():
-                raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"))
+                raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"), expected, trapped)
+    assert traps >= 2, "the test needs traps on its queries"
 
 
 # -- k-d tree -------------------------------------------------------------------------------------
@@ -133,26 +158,47 @@ def test_kdtree_build_hidden_exact_on_new_clouds(impl):
 
 
 def kd_decoy_case(points, leaf_size, seed, k=None, radius=None):
+    """Per fair query: the lying tree (traps swapped in), the lying cloud (decoys moved), decoys and traps."""
     tree = trees.kdtree(points, leaf_size)
     rng = np.random.default_rng(seed)
     for query, reached in fair_queries(points, seed, lambda q: trees.kdtree_reach(tree, points, q, k=k, radius=radius)):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
         lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        yield tree, query, lying, decoys
+        lying_tree, trapped, apart = trees.trap_swaps(tree, points, query, k=k, radius=radius)
+        yield lying_tree, query, lying, decoys, Traps(trapped, apart)
+
+
+class Traps:
+    """The swapped points of one query, and whether a swap keeps clear of the query's own leaf."""
+
+    def __init__(self, points, apart):
+        self.points, self.apart = points, apart
+
+    @staticmethod
+    def count(cases):
+        """Check that a test's queries planted traps, enough to fail a filter that spares its own leaf."""
+        pairs = sum(len(case.points) // 2 for case in cases)
+        assert pairs >= 2 and any(case.apart for case in cases), "the test needs traps on its queries"
 
 
 @pytest.mark.grades("kdtree_knn")
 @pytest.mark.points(8)
 def test_kdtree_knn_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 83)
+    planted = []
     for k in (1, 8):
-        for tree, query, lying, decoys in kd_decoy_case(points, 8, 84 + k, k=k):
+        for tree, query, lying, decoys, traps in kd_decoy_case(points, 8, 84 + k, k=k):
+            planted.append(traps)
             indices, distances = impl.kdtree_knn(tree, lying, query[None], k)
+            expected = trees.brute_knn(points, query, k)
             try:
-                check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "kdtree_knn")
+                check_knn(indices, distances, *[a[None] for a in expected], "kdtree_knn")
             except CheckFailed:
-                raise failure("kdtree_knn", indices, decoys, structure_failure("kdtree_knn")) from None
+                raise failure(
+                    "kdtree_knn", indices, decoys, structure_failure("kdtree_knn"), expected[0], traps.points
+                ) from None
+    Traps.count(planted)
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -170,12 +216,18 @@ def test_kdtree_knn_hidden_float32_input_and_k_equal_n(impl):
 @pytest.mark.points(4)
 def test_kdtree_radius_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 87)
-    for tree, query, lying, decoys in kd_decoy_case(points, 8, 88, radius=0.05):
+    planted = []
+    for tree, query, lying, decoys, traps in kd_decoy_case(points, 8, 88, radius=0.05):
+        planted.append(traps)
         result = impl.kdtree_radius(tree, lying, query[None], 0.05)
+        expected = trees.brute_radius(points, query, 0.05)
         try:
-            check_csr(result, [trees.brute_radius(points, query, 0.05)], "kdtree_radius")
+            check_csr(result, [expected], "kdtree_radius")
         except CheckFailed:
-            raise failure("kdtree_radius", result[1], decoys, structure_failure("kdtree_radius")) from None
+            raise failure(
+                "kdtree_radius", result[1], decoys, structure_failure("kdtree_radius"), expected[0], traps.points
+            ) from None
+    Traps.count(planted)
 
 
 # -- octree ---------------------------------------------------------------------------------------
@@ -209,19 +261,26 @@ def oc_decoy_case(points, leaf_size, seed, k=None, radius=None):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
         lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        yield tree, query, lying, decoys
+        lying_tree, trapped, apart = trees.trap_swaps(tree, points, query, k=k, radius=radius)
+        yield lying_tree, query, lying, decoys, Traps(trapped, apart)
 
 
 @pytest.mark.grades("octree_radius")
 @pytest.mark.points(3)
 def test_octree_radius_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 90)
-    for tree, query, lying, decoys in oc_decoy_case(points, 8, 91, radius=0.06):
+    planted = []
+    for tree, query, lying, decoys, traps in oc_decoy_case(points, 8, 91, radius=0.06):
+        planted.append(traps)
         result = impl.octree_radius(tree, lying, query[None], 0.06)
+        expected = trees.brute_radius(points, query, 0.06)
         try:
-            check_csr(result, [trees.brute_radius(points, query, 0.06)], "octree_radius")
+            check_csr(result, [expected], "octree_radius")
         except CheckFailed:
-            raise failure("octree_radius", result[1], decoys, structure_failure("octree_radius")) from None
+            raise failure(
+                "octree_radius", result[1], decoys, structure_failure("octree_radius"), expected[0], traps.points
+            ) from None
+    Traps.count(planted)
 
 
 def subtree(tree, node):
@@ -274,13 +333,19 @@ def test_octree_radius_hidden_reports_a_contained_octant_whole(impl):
 @pytest.mark.points(4)
 def test_octree_knn_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 94)
+    planted = []
     for k in (1, 6):
-        for tree, query, lying, decoys in oc_decoy_case(points, 8, 95 + k, k=k):
+        for tree, query, lying, decoys, traps in oc_decoy_case(points, 8, 95 + k, k=k):
+            planted.append(traps)
             indices, distances = impl.octree_knn(tree, lying, query[None], k)
+            expected = trees.brute_knn(points, query, k)
             try:
-                check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "octree_knn")
+                check_knn(indices, distances, *[a[None] for a in expected], "octree_knn")
             except CheckFailed:
-                raise failure("octree_knn", indices, decoys, structure_failure("octree_knn")) from None
+                raise failure(
+                    "octree_knn", indices, decoys, structure_failure("octree_knn"), expected[0], traps.points
+                ) from None
+    Traps.count(planted)
 
 
 @pytest.mark.grades("octree_knn")

@@ -21,6 +21,23 @@ READS_UNREACHED = (
     "then the far side only if it can still hold a neighbour"
 )
 
+FILTERS_BY_CELL = (
+    "your search dropped a point of a node it must read (it checks whether points lie in their node's cell): "
+    "the contract says to trust the tree; read only what the rule reaches, and keep every point you read"
+)
+
+
+def _cell_filtered(case, tree, points, queries, **argument):
+    """The cell-filter cheat on one search's arguments: every leaf, or every leaf but the query's own, filtered."""
+    tree, points, queries = case(tree, points, queries)
+    if "k" in argument:
+        argument = {"k": _k_of(argument["k"], len(points))}
+    else:
+        argument = {"radius": _radius_of(argument["radius"])}
+    return Variants(
+        tree_searches.cell_filtered_search(tree, points, queries, own_leaf=own, **argument) for own in (False, True)
+    )
+
 
 def _k_of(k, n):
     if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or not 1 <= k <= n:
@@ -161,6 +178,29 @@ def bst_brute(keys, left, right, query, k):
     return rank.astype(np.int64), np.abs(keys[rank] - query)
 
 
+def bst_interval_filtered(keys, left, right, query, k):
+    """The interval-filter cheat: every node read, its key dropped if outside the node's interval (from its
+    ancestors' keys: below a key to the left, at or above it to the right), the k nearest of the rest.
+
+    Two codings: a child's interval nested in its parent's (the parent's key clipped to it), or the parent's
+    key taken as is (they differ under a node whose key lies outside its own interval)."""
+    keys, left, right, query, k = _bst_case(keys, left, right, query, k)
+
+    def filtered(nested):
+        kept, stack = [], [(0, -math.inf, math.inf)]
+        while stack:
+            node, lo, hi = stack.pop()
+            if lo <= keys[node] <= hi:
+                kept.append(node)
+            below, above = (min(hi, keys[node]), max(lo, keys[node])) if nested else (keys[node], keys[node])
+            stack += [(int(c), a, b) for c, a, b in ((left[node], lo, below), (right[node], above, hi)) if c >= 0]
+        kept = np.array(sorted(kept), dtype=np.int64)
+        rank = np.lexsort((kept, np.abs(keys[kept] - query)))[:k]
+        return kept[rank], np.abs(keys[kept[rank]] - query)
+
+    return Variants(filtered(nested) for nested in (True, False))
+
+
 BST_KNN = Model(
     truth=bst_knn,
     output_dtypes=("int64", "float64"),
@@ -172,6 +212,7 @@ BST_KNN = Model(
             "k-th distance with a lower index is missed",
             lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, strict=True),
         ),
+        Mistake("filters_by_cell", FILTERS_BY_CELL, bst_interval_filtered),
     ),
 )
 
@@ -276,6 +317,11 @@ KDTREE_KNN = Model(
             "worst distance, not when |q[axis] - split| <= w2",
             lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, unsquared=True),
         ),
+        Mistake(
+            "filters_by_cell",
+            FILTERS_BY_CELL,
+            lambda tree, points, queries, k: _cell_filtered(_kd_case, tree, points, queries, k=k),
+        ),
     ),
 )
 
@@ -298,6 +344,11 @@ KDTREE_RADIUS = Model(
                 kdtree_radius(tree, points, queries, radius, strict_prune=prune, strict_keep=not prune)
                 for prune in (False, True)
             ),
+        ),
+        Mistake(
+            "filters_by_cell",
+            FILTERS_BY_CELL,
+            lambda tree, points, queries, radius: _cell_filtered(_kd_case, tree, points, queries, radius=radius),
         ),
     ),
 )
@@ -429,6 +480,11 @@ OCTREE_RADIUS = Model(
             "a return or break there loses the leaf's later points",
             lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, stop_at_miss=True),
         ),
+        Mistake(
+            "filters_by_cell",
+            FILTERS_BY_CELL,
+            lambda tree, points, queries, radius: _cell_filtered(_octree_case, tree, points, queries, radius=radius),
+        ),
     ),
 )
 
@@ -457,6 +513,11 @@ OCTREE_KNN = Model(
             "a child's cube meets the ball when its squared distance to the query is <= w2, inclusive: a point on "
             "a centre plane belongs to the lower octant and can lie on its face at exactly the k-th distance",
             lambda tree, points, queries, k: octree_knn(tree, points, queries, k, strict=True),
+        ),
+        Mistake(
+            "filters_by_cell",
+            FILTERS_BY_CELL,
+            lambda tree, points, queries, k: _cell_filtered(_octree_case, tree, points, queries, k=k),
         ),
     ),
 )
