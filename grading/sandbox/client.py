@@ -44,6 +44,7 @@ from grading.sandbox.processes import (
     become_subreaper,
     kill_uid,
     living_processes,
+    memfd_bytes,
     preexec,
     process_table,
     reap,
@@ -51,7 +52,7 @@ from grading.sandbox.processes import (
     ticks_since_boot,
     usage_of,
 )
-from grading.sandbox.walls import BUBBLEWRAP, WRITABLE_ROOTS, isolation, remove_files_of
+from grading.sandbox.walls import BUBBLEWRAP, UID, WRITABLE_ROOTS, isolation, remove_files_of, rules_uid
 
 
 class Worker:
@@ -85,8 +86,9 @@ class Worker:
         self.known_pids = None  # the worker's processes at the last count (None: not counted yet)
         self.extra = ()  # the running worker's own forbidden names (its module's, FORBIDDEN_IN_MODULE)
         self.exchange = None  # the memfd that holds a call's array arguments, shared with the worker
-        if self.uid is not None:
-            remove_files_of(self.uid)  # what an earlier grader, killed, may have left
+        self.exchange_inode = None
+        for uid in self._uids():
+            remove_files_of(uid)  # what an earlier grader, killed, may have left
 
     # -- process management ---------------------------------------------------
 
@@ -125,6 +127,7 @@ class Worker:
         if self.uid is not None:
             os.chown(self.work, self.uid, self.uid)
         self.exchange = os.memfd_create("pcl-call-arguments")
+        self.exchange_inode = os.fstat(self.exchange).st_ino
         command, env = self._command()
         self.known_pids = None  # a restarted worker's processes are new
         self.stderr = tempfile.TemporaryFile()
@@ -171,10 +174,18 @@ class Worker:
             self.exchange = None
 
     def close(self):
-        """Stop the worker and remove every file its uid left anywhere writable."""
+        """Stop the worker and remove every file its uids left anywhere writable."""
         self.stop()
-        if self.uid is not None:
-            remove_files_of(self.uid)
+        for uid in self._uids():
+            remove_files_of(uid)
+
+    def _uids(self):
+        """The sandbox uids this worker may run as: its slot's, and as a dedicated uid without
+        namespaces the slot's second uid, for the modules with rules of their own."""
+        base = self.isolation.uid
+        if base is None:
+            return []
+        return [base, rules_uid(base, True)] if self.isolation.level == UID else [base]
 
     def _leftovers(self):
         if self.uid is not None:
@@ -250,6 +261,8 @@ class Worker:
         if self.process is None or self.process.poll() is not None:
             self.stop()
             self.extra = extra
+            if self.isolation.level == UID:  # no masks: that module's uid is barred from its packages
+                self.uid = rules_uid(self.isolation.uid, extra)
             self.start()
         try:
             result = self._call(module, function, args, kwargs)
@@ -467,7 +480,9 @@ class CallUsage:
     unless its parent, a process of the call, reaped it (that time then
     shows in the parent's reaped children's time). Memory is the sum of
     every living process's proportional share of what it maps (``Pss``):
-    shared pages are counted once.
+    shared pages are counted once; and of the memfds they hold open, which
+    no mapping need show (each counted once, the call's own arguments
+    left out: they are counted where the worker maps them).
     """
 
     def __init__(self, worker, pids=None):
@@ -484,6 +499,7 @@ class CallUsage:
     def _read(self, rows, memory=True):
         """(CPU seconds so far, bytes of memory now, tasks now) of the processes ``rows``."""
         cpu, used, tasks, current = 0.0, 0, 0, {}
+        counted = {self.worker.exchange_inode}  # the call's own arguments: counted where they are mapped
         for pid, parent, _ in rows:
             usage = usage_of(pid, memory)
             if usage is None:
@@ -492,6 +508,8 @@ class CallUsage:
             current[pid] = (start, own + reaped, parent)
             if self.seen.get(pid, (None,))[0] != start and start < self.since:
                 self.start += own + reaped  # not this call's
+            if memory:
+                resident += memfd_bytes(pid, counted)
             cpu, used, tasks = cpu + own + reaped, used + resident, tasks + threads
         for pid, (start, total, parent) in self.seen.items():
             if current.get(pid, (None,))[0] == start:

@@ -118,8 +118,35 @@ def make_reachable(path):
             os.chmod(parent, stat.S_IMODE(mode) | stat.S_IXOTH)
 
 
-def bar_sandbox_uids(paths):
-    """Deny every sandbox uid all access to ``paths`` with a POSIX ACL (``setfacl``).
+def rules_uid(uid, extra):
+    """The uid that runs a module with forbidden names of its own (``extra``, such as
+    ``scipy.spatial`` in ``nn.py``) in the slot of sandbox ``uid``: the slot's second uid,
+    :data:`grading.config.SANDBOX_UID_SLOTS` above it, which ACLs bar from those packages too
+    (:func:`isolation`); ``uid`` itself for a module without rules of its own."""
+    return uid + config.SANDBOX_UID_SLOTS if uid is not None and extra else uid
+
+
+def module_rules_paths():
+    """Every entry the modules' own rules forbid (``FORBIDDEN_IN_MODULE``) on top of the
+    packages forbidden everywhere."""
+    everywhere = set(masked_paths())
+    extra = tuple(sorted({name for names in config.FORBIDDEN_IN_MODULE.values() for name in names}))
+    return [path for path in masked_paths(extra) if path not in everywhere]
+
+
+def bar_forbidden_packages():
+    """Bar every sandbox uid from the packages forbidden everywhere, and the slots' second uids
+    (:func:`rules_uid`) from those the modules' own rules forbid too; None when done, else why not."""
+    barred = bar_sandbox_uids(masked_paths())
+    if barred is None:
+        second = config.SANDBOX_UID_BASE + config.SANDBOX_UID_SLOTS
+        barred = bar_sandbox_uids(module_rules_paths(), range(second, second + config.SANDBOX_UID_SLOTS))
+    return barred
+
+
+def bar_sandbox_uids(paths, also_barred_from=None):
+    """Deny every sandbox uid (both uids of every slot, or the uids ``also_barred_from``)
+    all access to ``paths`` with a POSIX ACL (``setfacl``).
 
     Without namespaces nothing can hide a file from a process, but a named
     ACL entry with no permission bars that one uid and changes nothing for
@@ -131,7 +158,9 @@ def bar_sandbox_uids(paths):
         return None
     if not shutil.which("setfacl"):
         return "setfacl is not installed, to bar the sandbox uids from the forbidden packages (apt-get install acl)"
-    uids = range(config.SANDBOX_UID_BASE, config.SANDBOX_UID_BASE + config.SANDBOX_UID_SLOTS)
+    uids = range(config.SANDBOX_UID_BASE, config.SANDBOX_UID_BASE + 2 * config.SANDBOX_UID_SLOTS)
+    if also_barred_from is not None:
+        uids = also_barred_from
     entries = ",".join(f"u:{uid}:---" for uid in uids)
     completed = subprocess.run(
         ["setfacl", "-P", "-m", entries, "--", *[str(p) for p in paths]], capture_output=True, text=True
@@ -372,10 +401,12 @@ def isolation(uid=None):
     if not root:
         return Isolation(NONE, None, f"{why_not}; the grader is not root, so no dedicated uid")
     # The second wall: a dedicated uid that can read neither the grader's files nor the forbidden packages.
-    barred = bar_sandbox_uids(masked_paths())
+    barred = bar_forbidden_packages()
     if barred is not None:
         return Isolation(NONE, None, f"{why_not}; {barred}")
     wall = permission_wall(uid, [*protected_paths(), *masked_paths()])
+    if wall is None:
+        wall = permission_wall(rules_uid(uid, True), [*protected_paths(), *masked_paths(), *module_rules_paths()])
     if wall is not None:
         return Isolation(NONE, None, f"{why_not}; {wall}")
     network = network_wall(uid)

@@ -58,7 +58,10 @@ class _ForbiddenImports:
 def close_network():
     """Install a seccomp filter that fails every ``socket()`` (any address
     family; ``socketpair()`` stays) and ``io_uring_setup()`` (io_uring can
-    open sockets) with ``EACCES``, for this process and all it starts.
+    open sockets) with ``EACCES``, for this process and all it starts; and
+    ``shmget``, ``msgget`` and ``semget`` (SysV IPC objects outlive their
+    processes; POSIX shared memory is a file in ``/dev/shm``, counted and
+    removed like the others).
 
     Syscalls of another ABI (32-bit ``int 0x80``) kill the process
     (libseccomp's default for a foreign architecture).
@@ -72,7 +75,9 @@ def close_network():
         import pyseccomp as seccomp  # libseccomp's Python API, over ctypes
 
         deny = seccomp.SyscallFilter(seccomp.ALLOW)
-        for call in ("socket", "io_uring_setup"):
+        # SysV IPC objects outlive every process that made them (and, as a uid's, reach the next
+        # submission): refused too. Bubblewrap's IPC namespace dies with the sandbox instead.
+        for call in ("socket", "io_uring_setup", "shmget", "msgget", "semget"):
             deny.add_rule(seccomp.ERRNO(errno.EACCES), call)
         deny.load()  # sets no_new_privs first
     except Exception as exc:  # no libseccomp, or a kernel or container that refuses filters

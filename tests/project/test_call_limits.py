@@ -10,6 +10,7 @@ time, not the wall clock, so that a busy machine changes no verdict.
 """
 
 import os
+import subprocess
 import textwrap
 
 import numpy as np
@@ -17,7 +18,7 @@ import pytest
 
 from grading import config
 from grading.errors import SandboxError
-from grading.sandbox import Worker, isolation
+from grading.sandbox import UID, Isolation, Worker, isolation, reserve_uid
 from grading.staging import stage
 
 CHILDREN = textwrap.dedent(
@@ -333,3 +334,84 @@ def test_a_whole_lecture_1_grading_answering_large_arrays_stays_under_1_gib(tmp_
     peak_mib = int(peak.read_text().split()[1]) / 1024
     print(f"the grading process peaked at {peak_mib:.0f} MiB")
     assert peak_mib < 1024, f"the grading process peaked at {peak_mib:.0f} MiB"
+
+
+# -- memory no mapping shows, and memory that outlives its processes ------------------------------
+
+HOARDERS = textwrap.dedent(
+    """
+    import ctypes
+    import os
+    import time
+
+    import numpy as np
+
+
+    def memfds(count, mib, seconds):
+        # Shared memory that no process maps counts in no Pss: held by open memfds only.
+        fds = []
+        for i in range(count):
+            fd = os.memfd_create(f"hoard{i}")
+            os.posix_fallocate(fd, 0, mib * 2**20)
+            fds.append(fd)
+        time.sleep(seconds)
+        return np.array([len(fds)])
+
+
+    def sysv(key, mib):
+        # A SysV segment outlives every process that made it (and, as a uid's, reaches the next
+        # submission) unless the filter refuses it.
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.shmat.restype = ctypes.c_void_p
+        libc.shmat.argtypes = [ctypes.c_int, ctypes.c_void_p, ctypes.c_int]
+        libc.shmdt.argtypes = [ctypes.c_void_p]
+        segment = libc.shmget(key, ctypes.c_size_t(mib * 2**20), 0o1666)
+        if segment < 0:
+            raise PermissionError(ctypes.get_errno(), "shmget refused")
+        address = libc.shmat(segment, None, 0)
+        ctypes.memset(address, 1, mib * 2**20)
+        libc.shmdt(ctypes.c_void_p(address))
+        return np.array([segment])
+    """
+)
+
+
+def hoarding_worker(tmp_path, level):
+    package = tmp_path / "hoard" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "hoarders.py").write_text(HOARDERS)
+    isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
+    return Worker(stage(package).root, timeout=10, level=isolated)
+
+
+LEVELS = [
+    pytest.param("strongest", id="strongest"),
+    pytest.param("uid", id="uid", marks=pytest.mark.skipif(os.geteuid() != 0, reason="the uid mode needs root")),
+]
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_memory_held_in_memfds_no_process_maps_counts_for_the_call(tmp_path, monkeypatch, level):
+    monkeypatch.setattr(config, "CALL_MEMORY_LIMIT", 320 * 2**20, raising=False)
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = hoarding_worker(tmp_path, level)
+    try:
+        with pytest.raises(SandboxError, match=r"more than 320 MiB of memory across its processes"):
+            worker.call("hoarders", "memfds", (4, 100, 3.0), {})
+    finally:
+        worker.close()
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the uid mode needs root")
+def test_no_sysv_shared_memory_outlives_a_uid_worker(tmp_path):
+    key = 0x5EED35
+    worker = hoarding_worker(tmp_path, "uid")
+    try:
+        with pytest.raises(PermissionError):
+            worker.call("hoarders", "sysv", (key, 16), {})
+        worker.close()
+        assert f"{key:#010x}" not in subprocess.run(["ipcs", "-m"], capture_output=True, text=True).stdout
+    finally:
+        worker.close()
+        subprocess.run(["ipcrm", "-M", str(key)], capture_output=True)  # a failed run leaves nothing either

@@ -24,8 +24,9 @@ import pytest
 from _helpers import run_grader
 
 from grading import REPO_ROOT
-from grading.errors import ForbiddenAPI
+from grading.errors import ForbiddenAPI, SandboxError
 from grading.sandbox import UID, Isolation, Worker, reserve_uid
+from grading.sandbox.walls import bar_forbidden_packages
 from grading.staging import stage
 
 LEVELS = [
@@ -100,15 +101,16 @@ NEAREST_TWO = [0, int(np.argsort(((POINTS - POINTS[0]) ** 2).sum(axis=1))[1])]
 
 @pytest.mark.parametrize("level", LEVELS)
 def test_a_library_forbidden_in_one_module_fails_there_however_imported(tmp_path, level):
+    if level == "uid":
+        assert bar_forbidden_packages() is None
     impl = worker(tmp_path, level)
     try:
         assert impl.call("nn", "plain", (POINTS,), {}) == pytest.approx(POINTS.sum())
         assert list(impl.call("pca", "allowed", (POINTS,), {})[0]) == NEAREST_TWO  # lecture 1: allowed
-        # Masked under bubblewrap (the import finds nothing), a verdict as a uid: either way no answer.
-        with pytest.raises((ForbiddenAPI, AttributeError, ImportError)) as failure:
+        # Masked under bubblewrap, barred by ACLs for the slot's second uid (the import finds an
+        # empty namespace), and were it loaded, the mapped files' verdict: either way no answer.
+        with pytest.raises((ForbiddenAPI, AttributeError, ImportError)):
             impl.call("nn", "computed", (POINTS,), {})
-        if level == "uid":
-            assert failure.type is ForbiddenAPI and "scipy.spatial was loaded while nn.py ran" in str(failure.value)
         # The next call starts clean, and the other module's rules are its own again.
         assert impl.call("nn", "plain", (POINTS,), {}) == pytest.approx(POINTS.sum())
         assert list(impl.call("pca", "allowed", (POINTS,), {})[0]) == NEAREST_TWO
@@ -137,6 +139,61 @@ def test_a_copy_of_a_forbidden_package_in_another_folder_fails(tmp_path, level):
             impl.call("nn", "copied", (POINTS, str(copy)), {})
         if level == "uid":
             assert failure.type is ForbiddenAPI, failure.value
+    finally:
+        impl.close()
+
+
+FORKED = """
+import os
+import pickle
+import sys
+
+
+def _in_child(function, *args):
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        try:
+            os.close(read)
+            with os.fdopen(write, "wb") as pipe:
+                pipe.write(pickle.dumps(function(*args)))
+        finally:
+            os._exit(0)
+    os.close(write)
+    with os.fdopen(read, "rb") as pipe:
+        data = pipe.read()
+    os.waitpid(pid, 0)
+    return pickle.loads(data)
+
+
+def _search(points):
+    sys.meta_path[:] = [f for f in sys.meta_path if "Forbidden" not in type(f).__name__]
+    import scipy
+
+    return getattr(scipy, "spatial").cKDTree(points).query(points[:1], k=2)[1]
+
+
+def forked(points):
+    \"\"\"scipy.spatial in a child that exits before the call returns (no mapping left to read).\"\"\"
+    return _in_child(_search, points)
+"""
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_a_library_used_in_a_child_that_exits_before_the_call_returns_is_out_of_reach(tmp_path, level):
+    """As a dedicated uid, a module with rules of its own runs as its slot's second uid, which
+    ACLs bar from those packages: a child cannot load them either (bubblewrap masks them)."""
+    if level == "uid":
+        assert bar_forbidden_packages() is None
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "nn.py").write_text(FORKED)
+    isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
+    impl = Worker(stage(package).root, timeout=20, level=isolated)
+    try:
+        with pytest.raises((ForbiddenAPI, ImportError, AttributeError, EOFError, SandboxError)):
+            impl.call("nn", "forked", (POINTS,), {})
     finally:
         impl.close()
 
@@ -239,3 +296,24 @@ def test_a_pca_that_hides_its_in_place_change_loses_the_point(tmp_path):
     results, _ = run_grader(str(tmp_path / "clone"), "-k", "test_pca_does_not_modify_its_input", tmp_path=tmp_path)
     (test,) = [t for t in results["tests"] if t["name"].startswith("test_pca_does_not_modify_its_input")]
     assert test["score"] == 0 and "modified its input in place" in test["text"], test["text"]
+
+
+def test_the_mapped_files_name_the_forbidden_package_a_process_holds():
+    """The reading itself (grading/sandbox/mappings.py), on a process that holds scipy.spatial."""
+    import subprocess
+    import sys
+
+    from grading.sandbox import mappings
+
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import scipy.spatial, sys; print('ready', flush=True); sys.stdin.read()"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout.readline().strip() == "ready"
+        assert mappings.violation([holder.pid], ("scipy.spatial",)) == "scipy.spatial"
+        assert mappings.violation([holder.pid], ()) is None  # lecture 1's modules may hold it
+    finally:
+        holder.communicate("")
