@@ -107,8 +107,9 @@ STDERR_TAIL_BYTES = 64 * 1024  # of the worker's stderr, read from its end after
 # root: one per parallel job slot of `batch`, never shared with another
 # account; and, without namespaces, a second one per slot (SANDBOX_UID_SLOTS
 # above it) for the modules with rules of their own (FORBIDDEN_IN_MODULE),
-# which ACLs bar from those packages too: 2 * SANDBOX_UID_SLOTS uids in all. Override the base with PCL_SANDBOX_UID (e.g. on a machine where
-# these uids are taken).
+# which ACLs bar from those packages too: 2 * SANDBOX_UID_SLOTS uids in all.
+# Override the base with PCL_SANDBOX_UID (e.g. on a machine where these uids
+# are taken).
 SANDBOX_UID_BASE = int(os.environ.get("PCL_SANDBOX_UID", "60500"))
 SANDBOX_UID_SLOTS = 64
 # PCL_SANDBOX_NAMESPACES=0 grades as if namespaces were forbidden (as in most

@@ -19,11 +19,14 @@ sandbox, where the submission cannot change it. After each call
 
 Under bubblewrap a mapping's path is the sandbox's (``/sandbox/site-packages``
 for the host's site-packages), and it is translated back before matching.
-A process that loads a library and exits before the call returns escapes
-the reading; it can only have used a library from outside the environment
-(the environment's forbidden packages are masked under bubblewrap, barred
-by ACLs for a sandbox uid), which no submission can bring: staging refuses
-compiled files.
+What the reading cannot see: a library unmapped before the call returns
+(``dlclose``) or used in a child that exits first. The environment's
+forbidden packages are out of such a process's reach (masked under
+bubblewrap; barred by ACLs for the sandbox uids, a module's own for its
+second uid, :func:`grading.sandbox.walls.rules_uid`), so it would need a
+library the submission carries as data in its source and writes out itself
+(staging refuses compiled files, not text): a deliberate forgery, which
+this module does not claim to stop.
 """
 
 import shutil
