@@ -71,7 +71,7 @@ MAX_FEEDBACK_LINES = 12  # of one failed test's feedback
 # (grading/diagnosis.py); larger calls are recorded without their arguments.
 DIAGNOSIS_MAX_VALUES = 2_000_000
 # Bytes of the copies (arguments and answers) kept for the diagnosis over a whole grading
-# (grading/diagnosis.py, Recorder): calls past it are recorded without them. The
+# (grading/recording.py, Recorder): calls past it are recorded without them. The
 # reference's whole grading (both lectures) keeps 21 MB (measured, see the README).
 DIAGNOSIS_BUDGET = 64 * 1024**2
 # Wall-clock seconds of one submission's whole grading: tests not started by

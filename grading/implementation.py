@@ -16,9 +16,10 @@ from pathlib import Path
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
-from grading.diagnosis import Call, Recorder, contract_signature
+from grading.diagnosis import Call, contract_signature
 from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
 from grading.forbidden import read_source, scan_package
+from grading.recording import Recorder
 
 _counter = itertools.count()
 

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from grading.instructors import trees
+from grading.instructors import lying_trees
 from grading.instructors.trees import Best, brute_knn, brute_radius, cell_gap_squared, is_octree_leaf, squared_distances
 
 
@@ -209,7 +209,7 @@ def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=Fa
     points = points[:, :width]
     rows = []
     for query in np.asarray(queries, dtype=float).reshape(-1, np.asarray(queries).shape[-1])[:, :width]:
-        walk = trees.leaf_walk(tree, query)
+        walk = lying_trees.leaf_walk(tree, query)
         own = _own_leaf(tree, query) if own_leaf else None
         kept = []
         for leaf, lower, upper, _ in walk:

@@ -15,7 +15,7 @@ A search can also fail these tests by losing points where the rule reads
 no planted point, and the failure says that it answers wrong there instead
 of blaming the structure.
 
-The same trees also hold traps (:func:`grading.instructors.trees.trap_swaps`):
+The same trees also hold traps (:func:`grading.instructors.lying_trees.trap_swaps`):
 two points swapped in ``order`` between leaves that every lawful search
 reads, so that each is listed under a leaf whose cell it lies outside. A
 search that trusts the tree reads both leaves and answers right; one that
@@ -28,7 +28,7 @@ import pytest
 
 from grading.checks.nn import check_csr, check_kdtree, check_knn, check_octree
 from grading.errors import CheckFailed
-from grading.instructors import trees
+from grading.instructors import lying_trees, trees
 
 pytestmark = pytest.mark.hidden
 
@@ -126,7 +126,7 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
             if margin < MARGIN:
                 continue
             nearest = np.sort(np.abs(keys - query))[0]
-            trapped_keys, trapped = trees.bst_trap_swaps(keys, left, right, query, k)
+            trapped_keys, trapped = lying_trees.bst_trap_swaps(keys, left, right, query, k)
             traps += len(trapped) // 2
             lying = trapped_keys.copy()
             unreached = np.setdiff1d(np.arange(len(keys)), sorted(reached))
@@ -163,9 +163,9 @@ def kd_decoy_case(points, leaf_size, seed, k=None, radius=None):
     rng = np.random.default_rng(seed)
     for query, reached in fair_queries(points, seed, lambda q: trees.kdtree_reach(tree, points, q, k=k, radius=radius)):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
-        lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
+        lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        lying_tree, trapped, apart = trees.trap_swaps(tree, points, query, k=k, radius=radius)
+        lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
         yield lying_tree, query, lying, decoys, Traps(trapped, apart)
 
 
@@ -259,9 +259,9 @@ def oc_decoy_case(points, leaf_size, seed, k=None, radius=None):
 
     for query, reached in fair_queries(points, seed, reach):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
-        lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
+        lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        lying_tree, trapped, apart = trees.trap_swaps(tree, points, query, k=k, radius=radius)
+        lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
         yield lying_tree, query, lying, decoys, Traps(trapped, apart)
 
 

@@ -26,7 +26,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from grading.errors import CheckFailed
-from grading.instructors import tree_searches, trees
+from grading.instructors import lying_trees, tree_searches, trees
 from solutions import nn
 from tests.hidden import test_nn_hidden as hidden
 from tests.mutants import _bst_filter, _cell_filter, _plain_trees
@@ -231,7 +231,7 @@ def test_on_a_trapped_tree_lawful_searches_read_within_their_reads_and_answer_ri
     planted = apart = 0
     for query in rng.uniform(points.min(axis=0), points.max(axis=0), size=(40, 3)):
         for k, radius in ((int(rng.integers(1, 12)), None), (None, float(rng.uniform(0.03, 0.12)))):
-            lying, swapped, clear = trees.trap_swaps(tree, points, query, k=k, radius=radius)
+            lying, swapped, clear = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
             planted += len(swapped) // 2
             apart += clear
             true_reads = reached_leaves(tree, points, query, k=k, radius=radius)
@@ -257,7 +257,7 @@ def test_on_trapped_bst_keys_lawful_searches_read_within_their_reads_and_answer_
     planted = 0
     for query in rng.uniform(50, 950, 60):
         k = int(rng.integers(2, 30))
-        lying, swapped = trees.bst_trap_swaps(keys, left, right, query, k)
+        lying, swapped = lying_trees.bst_trap_swaps(keys, left, right, query, k)
         planted += len(swapped) // 2
         assert trees.bst_reach(lying, left, right, query, k)[0] <= trees.bst_reach(keys, left, right, query, k)[0]
         expected = np.lexsort((np.arange(len(keys)), np.abs(lying - query)))[:k]

@@ -4,7 +4,7 @@ book's theorem needs: the rule's answer unchanged, brute force's changed."""
 import numpy as np
 import pytest
 
-from grading.instructors import tree_searches, trees
+from grading.instructors import lying_trees, tree_searches, trees
 from solutions import nn
 
 # Run again with numba's bounds checking: tests/project/test_kernels.py.
@@ -53,7 +53,7 @@ def test_a_lying_tree_keeps_the_rules_answer_and_fools_brute_force(rng):
         for query in rng.uniform(0.1, 0.9, size=(5, 3)):
             reached = reach(tree, query)
             nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
-            lying, decoys = trees.decoy_points(points, tree, reached, query, nearest, rng)
+            lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng)
             assert len(decoys) > 10 * len(reached)
             original = trees.brute_knn(points, query, 4)[0]
             assert np.array_equal(search(tree, lying, query[None], 4)[0][0], original)  # the rule is not fooled

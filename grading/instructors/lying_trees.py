@@ -1,0 +1,347 @@
+"""The lying trees of lecture 2's structure tests: decoys and traps.
+
+Decoys are points moved near the query into leaves no lawful search reads;
+traps are points swapped between leaves every lawful search must read. Why
+every correct search passes them, and every search that reads what its rule
+skips or drops what it reads fails, is proved in
+:mod:`grading.instructors.trees`'s docstring; the trees, their builds and
+the contract's instrumented searches are there too.
+"""
+
+import math
+
+import numpy as np
+
+from grading.instructors.trees import DECOY_FRACTION, is_octree_leaf, squared_distances
+
+__all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps"]
+
+
+# -- lying trees ----------------------------------------------------------------------------------
+
+
+def decoy_points(points, tree, reached, query, nearest, rng, radius=None):
+    """``points`` with one point of every unreached node moved next to ``query``.
+
+    Parameters
+    ----------
+    points : ndarray, shape (N, D)
+    tree : dict
+        A k-d tree or octree of ``points``.
+    reached : set of int
+        The nodes the rule reads (:func:`kdtree_reach`, :func:`octree_reach`).
+    query : ndarray, shape (D,)
+    nearest : float
+        The true nearest distance (> 0): decoys land well inside it.
+    rng : numpy.random.Generator
+    radius : float, optional
+        For a radius search: decoys land inside it as well.
+
+    Returns
+    -------
+    moved : ndarray, shape (N, D)
+        The lying cloud (every other point unchanged).
+    decoys : ndarray of int64
+        The moved points' indices.
+    """
+    leaves = _leaves(tree)
+    covered = set()
+    for node in reached:
+        covered.update(range(tree["start"][node], tree["stop"][node]))
+    moved = np.array(points, dtype=float)
+    decoys = []
+    scale = DECOY_FRACTION * min(nearest, radius if radius else math.inf)
+    for leaf in leaves:
+        positions = [p for p in range(tree["start"][leaf], tree["stop"][leaf]) if p not in covered]
+        if not positions:
+            continue
+        index = int(tree["order"][positions[0]])
+        direction = rng.standard_normal(moved.shape[1])
+        direction /= np.linalg.norm(direction)
+        moved[index] = query + direction * scale * (1 + len(decoys) / (2 * len(leaves)))
+        decoys.append(index)
+    return moved, np.array(decoys, dtype=np.int64)
+
+
+def _leaves(tree):
+    if "axis" in tree:
+        return [int(i) for i in np.flatnonzero(tree["axis"] < 0)]
+    return [int(i) for i in np.flatnonzero(np.all(tree["children"] < 0, axis=1))]
+
+
+# -- traps: swaps between leaves every lawful search reads ----------------------------------------
+
+
+def leaf_walk(tree, query, within=None):
+    """The leaves in the rule's depth-first order, with their cells and the cubes above them.
+
+    The order is the contract's: the child on the query's side first (k-d
+    tree: left if ``q[a] <= split``; octree: the query's own code, then the
+    others in code order). A leaf's cell is its claimed geometry: the k-d
+    tree's box from its ancestors' splits (infinite outside the root), the
+    octree's cube ``center +- extent``.
+
+    Parameters
+    ----------
+    tree : dict
+        A k-d tree or an octree.
+    query : ndarray, shape (D,)
+    within : float, optional
+        Only the leaves whose cell's squared distance is at most this (the
+        subtrees beyond it are not walked).
+
+    Returns
+    -------
+    list of (int, ndarray, ndarray, list of int)
+        ``(leaf, lower, upper, path)`` in walk order; ``path`` holds the
+        nodes from the root to the leaf, both included.
+    """
+    query = np.asarray(query, dtype=float)
+    walk = []
+    if "axis" in tree:
+        dim = len(query)
+        stack = [(0, np.full(dim, -math.inf), np.full(dim, math.inf), [0])]
+        while stack:
+            node, lower, upper, path = stack.pop()
+            if within is not None and _box_gap_squared(lower, upper, query) > within:
+                continue
+            if tree["axis"][node] < 0:
+                walk.append((node, lower, upper, path))
+                continue
+            a, s = tree["axis"][node], tree["split"][node]
+            left_upper, right_lower = upper.copy(), lower.copy()
+            left_upper[a], right_lower[a] = min(upper[a], s), max(lower[a], s)
+            left = (int(tree["left"][node]), lower, left_upper, path + [int(tree["left"][node])])
+            right = (int(tree["right"][node]), right_lower, upper, path + [int(tree["right"][node])])
+            stack += [right, left] if query[a] <= s else [left, right]  # the near child is popped first
+        return walk
+    query = query[:3]
+    stack = [(0, [0])]
+    while stack:
+        node, path = stack.pop()
+        center, extent = tree["center"][node], tree["extent"][node]
+        if within is not None and _box_gap_squared(center - extent, center + extent, query) > within:
+            continue
+        if is_octree_leaf(tree, node):
+            walk.append((node, center - extent, center + extent, path))
+            continue
+        own = sum(1 << j for j in range(3) if query[j] > center[j])
+        codes = [own] + [c for c in range(8) if c != own]
+        for code in reversed(codes):
+            child = int(tree["children"][node, code])
+            if child >= 0:
+                stack.append((child, path + [child]))
+    return walk
+
+
+def _box_gap_squared(lower, upper, query):
+    return float(np.sum((np.maximum(lower - query, 0.0) + np.maximum(query - upper, 0.0)) ** 2))
+
+
+def _strictly_inside(point, lower, upper):
+    return bool(np.all((point > lower) & (point < upper)))
+
+
+def _contained_on_path(tree, path, query, radius):
+    """Whether the octree radius search's contains test is true (or near) at a node of ``path``."""
+    for node in path:
+        reach2 = float(np.sum((np.abs(query - tree["center"][node]) + tree["extent"][node]) ** 2))
+        if reach2 <= radius**2 * (1 + TRAP_MARGIN):
+            return True
+    return False
+
+
+# Traps keep this relative distance from every decision they rely on (a cell's distance against the
+# k-th distance or the radius, a point's distance against the k-th distance).
+TRAP_MARGIN = 1e-6
+# A swapped point lies at least this far outside the cell that now lists it, relative to the k-th
+# distance or the radius (the pair farthest out is chosen).
+SWAP_CLEARANCE = 1e-3
+
+
+def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
+    """``tree`` with points swapped between leaves that every lawful search reads.
+
+    A trap takes a point p that is in the answer and a point u, each strictly
+    inside the cell of its leaf, B and A, and exchanges their places in
+    ``order``: the tree now lists p under A and u under B, each outside the
+    cell of the leaf that lists it, first in that leaf's range (so that a
+    leaf scan that stops early, a fault of its own, does not lose them and
+    read as a filter). The points themselves do not move.
+
+    Radius search: A and B are any two leaves within ``radius`` of the query
+    (cell distance), neither the query's own leaf nor, in an octree, under a
+    node that the ball contains; p is a point of A within the radius, u any
+    point of B. kNN: A and B lie within the k-th distance, A comes before B
+    in the rule's depth-first order and is strictly nearer (cell distance),
+    p is an answer point of B and u a point of A beyond the k-th distance
+    (the module docstring proves why every lawful search still answers
+    right). Each pair uses leaves of its own; the first pair is searched
+    among leaves other than the query's own one.
+
+    Parameters
+    ----------
+    tree : dict
+        A k-d tree or an octree of ``points``, true to its points.
+    points : ndarray, shape (N, D)
+    query : ndarray, shape (D,)
+    k : int, optional
+    radius : float, optional
+        Exactly one of ``k`` and ``radius``.
+    pairs : int, default 2
+        At most this many swaps.
+
+    Returns
+    -------
+    lying : dict
+        A copy of ``tree`` with the swaps in ``order``.
+    swapped : ndarray of int64, shape (2 * n_pairs,)
+        The swapped points' indices, p then u for each pair.
+    own_leaf_kept : bool
+        Whether some swap leaves both of its leaves apart from the query's
+        own leaf (a search that filters all but its own leaf fails it).
+    """
+    points = np.asarray(points, dtype=float)
+    octree = "axis" not in tree
+    xyz = points[:, :3] if octree else points
+    query = np.asarray(query, dtype=float)[: xyz.shape[1]]
+    s = squared_distances(xyz, query)
+    if k is not None:
+        answer = np.lexsort((np.arange(len(s)), s))[:k]
+        bound2 = float(s[answer[-1]])
+    else:
+        answer = np.flatnonzero(s <= radius**2)
+        bound2 = radius**2
+    in_answer = np.zeros(len(s), dtype=bool)
+    in_answer[answer] = True
+    walk = leaf_walk(tree, query, within=bound2)
+    own = {leaf for leaf, lower, upper, _ in walk if _box_gap_squared(lower, upper, query) == 0.0}
+    necessary = []  # (walk position, leaf, gap2, lower, upper, positions in order of its points inside it)
+    for position, (leaf, lower, upper, path) in enumerate(walk):
+        gap2 = _box_gap_squared(lower, upper, query)
+        if gap2 > bound2 * (1 - TRAP_MARGIN):
+            continue
+        if radius is not None and octree and _contained_on_path(tree, path, query, radius):
+            continue
+        slots = [
+            p
+            for p in range(tree["start"][leaf], tree["stop"][leaf])
+            if _strictly_inside(xyz[tree["order"][p]], lower, upper)
+        ]
+        necessary.append((position, leaf, gap2, lower, upper, slots))
+    order = np.array(tree["order"], dtype=np.int64)
+    used, swapped, apart = set(), [], False
+    for attempt in range(2 * pairs):
+        if len(swapped) == 2 * pairs:
+            break
+        avoid_own = attempt == 0 or radius is not None
+        found = _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, used | (own if avoid_own else set()))
+        if found is None:
+            continue
+        (a_leaf, a_slot), (b_leaf, b_slot) = found
+        used |= {a_leaf, b_leaf}
+        apart = apart or not ({a_leaf, b_leaf} & own)
+        swapped += [int(order[b_slot if k is not None else a_slot]), int(order[a_slot if k is not None else b_slot])]
+        order[a_slot], order[b_slot] = order[b_slot], order[a_slot]
+        for leaf, slot in ((a_leaf, a_slot), (b_leaf, b_slot)):  # each newcomer first in its leaf
+            first = tree["start"][leaf]
+            order[first : slot + 1] = np.roll(order[first : slot + 1], 1)
+    lying = {key: np.array(value, copy=True) for key, value in tree.items()}
+    lying["order"] = order
+    return lying, np.array(swapped, dtype=np.int64), apart
+
+
+def _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, excluded):
+    """Two slots ``(leaf, position in order)`` to swap (see :func:`trap_swaps`), or None if there are none.
+
+    Of the pairs that qualify, the one whose two points end farthest outside
+    their new cells, so that a filter with a tolerance drops them too.
+    """
+    leaves = [entry for entry in necessary if entry[1] not in excluded]
+    best, best_score = None, SWAP_CLEARANCE * math.sqrt(bound2)
+    for a_position, a_leaf, a_gap2, a_lower, a_upper, a_slots in leaves:
+        if k is None:  # radius: p of A within the radius
+            a_points = [p for p in a_slots if s[order[p]] <= bound2 * (1 - TRAP_MARGIN)]
+        else:  # kNN: u of A beyond the k-th distance
+            a_points = [p for p in a_slots if not in_answer[order[p]] and s[order[p]] >= bound2 * (1 + TRAP_MARGIN)]
+        for b_position, b_leaf, b_gap2, b_lower, b_upper, b_slots in leaves:
+            if b_leaf == a_leaf:
+                continue
+            if k is None:  # radius: u of B anywhere
+                b_points = b_slots
+            elif b_position <= a_position or a_gap2 >= b_gap2 * (1 - TRAP_MARGIN):
+                continue
+            else:  # kNN: p of B in the answer, A before B and nearer
+                b_points = [p for p in b_slots if in_answer[order[p]]]
+            for a_slot in a_points:
+                out_a = math.sqrt(_box_gap_squared(b_lower, b_upper, xyz[order[a_slot]]))
+                if out_a <= best_score:
+                    continue
+                for b_slot in b_points:
+                    score = min(out_a, math.sqrt(_box_gap_squared(a_lower, a_upper, xyz[order[b_slot]])))
+                    if score > best_score:
+                        best, best_score = ((a_leaf, a_slot), (b_leaf, b_slot)), score
+    return best
+
+
+def bst_trap_swaps(keys, left, right, query, k, pairs=2):
+    """``keys`` with the keys of childless nodes swapped where every lawful BST search reads both.
+
+    A BST's keys are its geometry too, so only the keys of nodes without
+    children can move without changing where a search goes. A pair is two
+    such nodes A and B whose intervals (from their ancestors' keys: ``[lo,
+    key)`` to the left, ``[key, hi]`` to the right) lie within the k-th
+    distance, A before B in the rule's depth-first order and strictly nearer;
+    B's key is among the k nearest and strictly nearer the query than A's
+    (which may be too: the keys are distinct, so the nearer key moving to
+    the leaf read first is all the argument of :func:`trap_swaps` needs).
+    After the swap node A holds B's key, outside A's interval: a search that
+    drops the keys outside their node's interval loses node A from its
+    answer.
+
+    Returns
+    -------
+    lying : ndarray, shape (N,)
+        The keys with the swaps (the expected answer is brute force on them).
+    swapped : ndarray of int64
+        The swapped node ids, A then B for each pair.
+    """
+    keys = np.asarray(keys, dtype=float)
+    gaps = np.abs(keys - query)
+    answer = np.lexsort((np.arange(len(keys)), gaps))[:k]
+    bound = float(gaps[answer[-1]])
+    in_answer = np.zeros(len(keys), dtype=bool)
+    in_answer[answer] = True
+    walk, stack = [], [(0, -math.inf, math.inf)]
+    while stack:  # depth first, the query's side first
+        node, lo, hi = stack.pop()
+        if left[node] < 0 and right[node] < 0:
+            gap = max(lo - query, query - hi, 0.0)
+            inside = lo < keys[node] < hi
+            if gap <= bound * (1 - TRAP_MARGIN) and inside:
+                walk.append((len(walk), int(node), gap, lo, hi))
+            continue
+        children = [(left[node], lo, keys[node]), (right[node], keys[node], hi)]
+        if query < keys[node]:
+            children.reverse()  # the left child is popped first
+        stack.extend((int(c), a, b) for c, a, b in children if c >= 0)
+    lying = keys.copy()
+    used, swapped = set(), []
+    for a_position, a, a_gap, a_lo, a_hi in walk:
+        if len(swapped) == 2 * pairs or a in used:
+            continue
+        for b_position, b, b_gap, b_lo, b_hi in walk:
+            if b in used or b_position <= a_position or not in_answer[b] or a_gap >= b_gap * (1 - TRAP_MARGIN):
+                continue
+            if gaps[a] <= gaps[b] * (1 + TRAP_MARGIN) + bound * TRAP_MARGIN:  # the nearer key moves earlier
+                continue
+            clearance = SWAP_CLEARANCE * bound
+            if not (keys[b] < a_lo - clearance or keys[b] > a_hi + clearance):
+                continue
+            if not (keys[a] < b_lo - clearance or keys[a] > b_hi + clearance):
+                continue
+            lying[a], lying[b] = keys[b], keys[a]
+            used |= {a, b}
+            swapped += [a, b]
+            break
+    return lying, np.array(swapped, dtype=np.int64)
