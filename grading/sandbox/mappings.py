@@ -95,6 +95,15 @@ def mapped_files(pid):
     return files
 
 
+@cache
+def _prefixes(extra):
+    """((forbidden folder + "/", dotted name) ..., (allowed folder + "/") ...) for a module
+    forbidden ``extra`` too: strings, for the hot path of every call."""
+    forbidden = tuple((f"{str(entry).rstrip('/')}/", name) for entry, name in forbidden_files(extra))
+    allowed = tuple(f"{str(root).rstrip('/')}/" for root in allowed_code_roots())
+    return forbidden, allowed
+
+
 def _under(path, prefixes):
     """Whether ``path`` (a string) is one of ``prefixes`` (strings ending in ``/``) or below it."""
     return path.startswith(prefixes) or f"{path}/".startswith(prefixes)
@@ -118,14 +127,13 @@ def violation(pids, extra=(), bubblewrap=False):
         ``"scipy.spatial"`` (a forbidden package, by its dotted name) or
         ``"native code from outside the environment"``; None if clean.
     """
-    forbidden = forbidden_files(tuple(extra))
-    forbidden_prefixes = tuple(f"{str(entry).rstrip('/')}/" for entry, _ in forbidden)
-    allowed = tuple(f"{str(root).rstrip('/')}/" for root in allowed_code_roots())
+    forbidden, allowed = _prefixes(tuple(extra))
+    every_forbidden = tuple(prefix for prefix, _ in forbidden)
     for pid in pids:
         for raw, executable in mapped_files(pid).items():
             path = _host_path(raw.removesuffix(" (deleted)"), bubblewrap)
-            if _under(path, forbidden_prefixes):
-                return next(name for entry, name in forbidden if _under(path, (f"{str(entry).rstrip('/')}/",)))
+            if _under(path, every_forbidden):
+                return next(name for prefix, name in forbidden if _under(path, (prefix,)))
             if executable and not _under(path, allowed):
                 return "native code from outside the environment"
     return None

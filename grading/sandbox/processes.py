@@ -87,38 +87,54 @@ def become_subreaper():
         pass
 
 
-_STATUS_FIELDS = re.compile(rb"^(State|PPid|Uid|NSpgid):\s*(\S+)", re.MULTILINE)  # Uid: the real one first
+_STATUS_FIELDS = re.compile(rb"^(State|PPid|Uid|NSpgid|NSsid):\s*(\S+)", re.MULTILINE)  # the first value of each
 
 
-def living_processes():
-    """(pid, parent pid, process group, real uid) of every living process (no zombies).
+def _read_proc(path, limit):
+    """The first ``limit`` bytes of a /proc file (plain ``os`` calls: read after every call)."""
+    handle = os.open(path, os.O_RDONLY)
+    try:
+        return os.read(handle, limit)
+    finally:
+        os.close(handle)
 
-    From /proc/PID/status, whose ``Uid:`` line holds the real uid: the owner
-    of a process's /proc files is root once it makes itself non-dumpable
+
+def _statuses():
+    """(pid, state, parent pid, real uid, process group, session) of every process, zombies
+    included, from /proc/PID/status.
+
+    Its ``Uid:`` line holds the real uid first: the owner of a process's
+    /proc files is root once it makes itself non-dumpable
     (``prctl(PR_SET_DUMPABLE, 0)``), which would hide it from
-    :func:`kill_uid`. Called after every graded call, so plain ``os`` calls
-    rather than ``pathlib``. The status file escapes newlines in the
-    process's name, so a name cannot forge a line.
+    :func:`kill_uid`. ``NSpgid`` and ``NSsid`` hold the group and session
+    in our namespace first. The file escapes newlines in the process's name,
+    so a name cannot forge a line.
     """
-    found = []
     with os.scandir("/proc") as entries:
         for entry in entries:
             if not entry.name.isdigit():
                 continue
             try:
-                handle = os.open(f"/proc/{entry.name}/status", os.O_RDONLY)
-                try:
-                    status = os.read(handle, 1 << 16)
-                finally:
-                    os.close(handle)
+                status = _read_proc(f"/proc/{entry.name}/status", 1 << 16)
                 fields = dict(_STATUS_FIELDS.findall(status, status.find(b"\n")))  # after the Name line
-                state, parent, uid = fields[b"State"], int(fields[b"PPid"]), int(fields[b"Uid"])
-                group = int(fields.get(b"NSpgid", -1))
+                yield (
+                    int(entry.name),
+                    fields[b"State"],
+                    int(fields[b"PPid"]),
+                    int(fields[b"Uid"]),
+                    int(fields.get(b"NSpgid", -1)),
+                    int(fields.get(b"NSsid", -1)),
+                )
             except (OSError, KeyError, IndexError, ValueError):
                 continue
-            if state != b"Z":
-                found.append((int(entry.name), parent, group, uid))
-    return found
+
+
+def living_processes():
+    """(pid, parent pid, process group, real uid) of every living process (no zombies).
+
+    Called after every graded call (:func:`_statuses`).
+    """
+    return [(pid, parent, group, uid) for pid, state, parent, uid, group, _ in _statuses() if state != b"Z"]
 
 
 def reap():
@@ -154,19 +170,12 @@ _CLOCK_TICKS = os.sysconf("SC_CLK_TCK") if hasattr(os, "sysconf") else 100
 def stat_of(pid):
     """(threads, CPU seconds with reaped children) of a process, from /proc/PID/stat; (0, 0) once it is gone."""
     try:
-        handle = os.open(f"/proc/{pid}/stat", os.O_RDONLY)
-        try:
-            text = os.read(handle, 4096)
-        finally:
-            os.close(handle)
+        text = _read_proc(f"/proc/{pid}/stat", 4096)
     except OSError:
         return 0, 0.0
     fields = text[text.rfind(b")") + 2 :].split()  # after the name, which may hold spaces
     # fields[0] is field 3 (state): utime, stime, cutime, cstime are fields 14-17, num_threads 20
     return int(fields[17]), sum(int(v) for v in fields[11:15]) / _CLOCK_TICKS
-
-
-_TABLE_FIELDS = re.compile(rb"^(State|PPid|Uid|NSsid):\s*(\S+)", re.MULTILINE)  # NSsid: in our namespace first
 
 
 def process_table():
@@ -176,24 +185,7 @@ def process_table():
     the CPU time it used, and a call's account must count it: a parent that
     never reaps its children would otherwise hide their time.
     """
-    found = []
-    with os.scandir("/proc") as entries:
-        for entry in entries:
-            if not entry.name.isdigit():
-                continue
-            try:
-                handle = os.open(f"/proc/{entry.name}/status", os.O_RDONLY)
-                try:
-                    status = os.read(handle, 1 << 16)
-                finally:
-                    os.close(handle)
-                fields = dict(_TABLE_FIELDS.findall(status, status.find(b"\n")))
-                state, parent, uid = fields[b"State"], int(fields[b"PPid"]), int(fields[b"Uid"])
-                session = int(fields.get(b"NSsid", -1))
-            except (OSError, KeyError, IndexError, ValueError):
-                continue
-            found.append((int(entry.name), parent, session, uid, state == b"Z"))
-    return found
+    return [(pid, parent, session, uid, state == b"Z") for pid, state, parent, uid, _, session in _statuses()]
 
 
 def usage_of(pid, memory=True):
@@ -206,11 +198,7 @@ def usage_of(pid, memory=True):
     resident set; 0 for a zombie or with ``memory=False``.
     """
     try:
-        handle = os.open(f"/proc/{pid}/stat", os.O_RDONLY)
-        try:
-            text = os.read(handle, 4096)
-        finally:
-            os.close(handle)
+        text = _read_proc(f"/proc/{pid}/stat", 4096)
     except OSError:
         return None
     fields = text[text.rfind(b")") + 2 :].split()
@@ -221,11 +209,7 @@ def usage_of(pid, memory=True):
     if memory and fields[0] != b"Z":
         resident = int(fields[21]) * _PAGE_SIZE
         try:
-            handle = os.open(f"/proc/{pid}/smaps_rollup", os.O_RDONLY)
-            try:
-                rollup = os.read(handle, 1 << 14)
-            finally:
-                os.close(handle)
+            rollup = _read_proc(f"/proc/{pid}/smaps_rollup", 1 << 14)
             match = _PSS.search(rollup)
             if match:
                 resident = int(match.group(1)) * 1024

@@ -3,13 +3,12 @@ as a dedicated uid, disk, read while the call runs by :class:`grading.sandbox.cl
 
 import os
 import signal
-import stat
 import time
 
 from grading import config
 from grading.errors import SandboxError
 from grading.sandbox.processes import memfd_bytes, ticks_since_boot, usage_of
-from grading.sandbox.walls import BUBBLEWRAP, WRITABLE_ROOTS
+from grading.sandbox.walls import BUBBLEWRAP, WRITABLE_ROOTS, files_of
 
 TIMEOUT, DIED = SandboxError.TIMEOUT, SandboxError.DIED
 
@@ -119,26 +118,6 @@ def _size(count):
 
 
 def disk_usage_of(uid, roots):
-    """Bytes of the files ``uid`` owns below ``roots`` (allocated blocks: a sparse file counts what it holds).
-
-    As :func:`grading.sandbox.walls.remove_files_of` finds them: a dedicated
-    uid creates entries only in world-writable folders (recursed into) and
-    in its own folders (recursed into too). Links are never followed.
-    """
-    total, stack = 0, [root for root in roots if root]
-    while stack:
-        folder = stack.pop()
-        try:
-            entries = list(os.scandir(folder))
-        except OSError:
-            continue
-        for entry in entries:
-            try:
-                info = entry.stat(follow_symlinks=False)
-            except OSError:
-                continue
-            if info.st_uid == uid:
-                total += info.st_blocks * 512
-            if stat.S_ISDIR(info.st_mode) and (info.st_uid == uid or info.st_mode & stat.S_IWOTH):
-                stack.append(entry.path)
-    return total
+    """Bytes of the files ``uid`` owns below ``roots`` (allocated blocks: a sparse file counts
+    what it holds), found as :func:`grading.sandbox.walls.remove_files_of` finds them."""
+    return sum(info.st_blocks * 512 for _, info in files_of(uid, roots, into_own=True))

@@ -174,16 +174,14 @@ def bar_sandbox_uids(paths, also_barred_from=None):
 WRITABLE_ROOTS = ("/tmp", "/var/tmp", "/dev/shm", "/run/lock", "/var/lock", "/dev/mqueue")
 
 
-def remove_files_of(uid, roots=WRITABLE_ROOTS):
-    """Remove every file and folder that ``uid`` owns below ``roots``.
+def files_of(uid, roots=WRITABLE_ROOTS, into_own=False):
+    """(path, stat) of every entry that ``uid`` owns below ``roots``; links never followed.
 
     A dedicated uid can create entries only where others may write: in
-    world-writable folders (recursed into) and in its own folders (removed
-    whole). Called before and after each submission in the uid mode, whose
-    processes are all dead by then, so that nothing one submission wrote is
-    there for the next one to find. Links are removed, never followed.
+    world-writable folders (recursed into, 32 levels at most) and in its own
+    folders (recursed into whole with ``into_own``; else listed as one entry).
     """
-    stack = [(root, 0) for root in roots]
+    stack = [(root, 0) for root in roots if root]
     while stack:
         folder, depth = stack.pop()
         try:
@@ -195,17 +193,29 @@ def remove_files_of(uid, roots=WRITABLE_ROOTS):
                 info = entry.stat(follow_symlinks=False)
             except OSError:
                 continue
-            is_folder = stat.S_ISDIR(info.st_mode)
-            if info.st_uid == uid:
-                if is_folder:
-                    shutil.rmtree(entry.path, ignore_errors=True)
-                else:
-                    try:
-                        os.unlink(entry.path)
-                    except OSError:
-                        pass
-            elif is_folder and info.st_mode & stat.S_IWOTH and depth < 32:
+            owned = info.st_uid == uid
+            if owned:
+                yield entry.path, info
+            if not stat.S_ISDIR(info.st_mode):
+                continue
+            if (owned and into_own) or (not owned and info.st_mode & stat.S_IWOTH and depth < 32):
                 stack.append((entry.path, depth + 1))
+
+
+def remove_files_of(uid, roots=WRITABLE_ROOTS):
+    """Remove every file and folder that ``uid`` owns below ``roots`` (:func:`files_of`; its own
+    folders whole). Called before and after each submission in the uid mode, whose processes
+    are all dead by then, so that nothing one submission wrote is there for the next one to
+    find. Links are removed, never followed.
+    """
+    for path, info in list(files_of(uid, roots)):
+        if stat.S_ISDIR(info.st_mode):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
 
 
 def _probe_script(paths):
