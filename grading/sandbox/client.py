@@ -257,9 +257,12 @@ class Worker:
             self.stop()  # a module with rules of its own runs in a worker of its own
         if self.process is None or self.process.poll() is not None:
             self.stop()
-            self.extra = extra
-            if self.isolation.level == UID:  # no masks: that module's uid is barred from its packages
+            if self.isolation.level == UID and self.extra != extra:
+                # No masks: that module's uid is barred from its packages, and nothing the
+                # other uid of the slot wrote (a copy of them, say) is left for it to find.
+                remove_files_of(self.uid)
                 self.uid = rules_uid(self.isolation.uid, extra)
+            self.extra = extra
             self.start()
         try:
             result = self._call(module, function, args, kwargs)

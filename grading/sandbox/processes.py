@@ -11,6 +11,7 @@ import os
 import re
 import resource
 import signal
+import stat
 import sys
 import time
 
@@ -218,10 +219,11 @@ def usage_of(pid, memory=True):
     return int(fields[19]), own, reaped, int(fields[17]), resident
 
 
-def memfd_bytes(pid, counted):
-    """Bytes of the memfds ``pid`` holds open, each file counted once over ``counted`` (a set of
-    inode numbers, shared across one reading of a call's processes; pre-filled to leave a file
-    out). Memory held in a memfd that no process maps shows in no ``Pss``."""
+def unlisted_bytes(pid, counted):
+    """Bytes of the files ``pid`` holds open that no folder lists: memfds, and files deleted
+    while open (in ``/tmp`` or ``/dev/shm``, RAM or disk that no walk of the folders finds and
+    no mapping need show). Each file is counted once over ``counted`` (a set of inode numbers
+    shared across one reading of a call's processes; pre-filled to leave a file out)."""
     folder = f"/proc/{pid}/fd"
     try:
         names = os.listdir(folder)
@@ -231,14 +233,13 @@ def memfd_bytes(pid, counted):
     for name in names:
         path = f"{folder}/{name}"
         try:
-            if not os.readlink(path).startswith("/memfd:"):
-                continue
             info = os.stat(path)
         except OSError:  # closed meanwhile
             continue
-        if info.st_ino not in counted:
-            counted.add(info.st_ino)
-            total += info.st_blocks * 512
+        if not stat.S_ISREG(info.st_mode) or info.st_nlink > 0 or info.st_ino in counted:
+            continue  # a memfd has no link either
+        counted.add(info.st_ino)
+        total += info.st_blocks * 512
     return total
 
 

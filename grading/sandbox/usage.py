@@ -7,7 +7,7 @@ import time
 
 from grading import config
 from grading.errors import SandboxError
-from grading.sandbox.processes import memfd_bytes, ticks_since_boot, usage_of
+from grading.sandbox.processes import ticks_since_boot, unlisted_bytes, usage_of
 from grading.sandbox.walls import BUBBLEWRAP, WRITABLE_ROOTS, files_of
 
 TIMEOUT, DIED = SandboxError.TIMEOUT, SandboxError.DIED
@@ -27,8 +27,9 @@ class CallUsage:
     shows in the parent's reaped children's time). Memory is the sum of
     every living process's proportional share of what it maps (``Pss``):
     shared pages are counted once; and of the memfds they hold open, which
-    no mapping need show (each counted once, the call's own arguments
-    left out: they are counted where the worker maps them).
+    no mapping need show, and the files they hold open after deleting them
+    (each counted once, the call's own arguments left out: they are counted
+    where the worker maps them).
     """
 
     def __init__(self, worker, pids=None):
@@ -55,7 +56,7 @@ class CallUsage:
             if self.seen.get(pid, (None,))[0] != start and start < self.since:
                 self.start += own + reaped  # not this call's
             if memory:
-                resident += memfd_bytes(pid, counted)
+                resident += unlisted_bytes(pid, counted)
             cpu, used, tasks = cpu + own + reaped, used + resident, tasks + threads
         for pid, (start, total, parent) in self.seen.items():
             if current.get(pid, (None,))[0] == start:

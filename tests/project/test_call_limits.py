@@ -358,6 +358,18 @@ HOARDERS = textwrap.dedent(
         return np.array([len(fds)])
 
 
+    def deleted(count, mib, seconds):
+        # Files deleted while open: no walk of the folders finds them, no mapping shows them.
+        held = []
+        for i in range(count):
+            handle = open(f"/tmp/hoard{i}", "wb")
+            os.posix_fallocate(handle.fileno(), 0, mib * 2**20)
+            os.unlink(f"/tmp/hoard{i}")
+            held.append(handle)
+        time.sleep(seconds)
+        return np.array([len(held)])
+
+
     def sysv(key, mib):
         # A SysV segment outlives every process that made it (and, as a uid's, reaches the next
         # submission) unless the filter refuses it.
@@ -399,6 +411,18 @@ def test_memory_held_in_memfds_no_process_maps_counts_for_the_call(tmp_path, mon
     try:
         with pytest.raises(SandboxError, match=r"more than 320 MiB of memory across its processes"):
             worker.call("hoarders", "memfds", (4, 100, 3.0), {})
+    finally:
+        worker.close()
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_files_deleted_while_open_count_for_the_call(tmp_path, monkeypatch, level):
+    monkeypatch.setattr(config, "CALL_MEMORY_LIMIT", 160 * 2**20, raising=False)
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = hoarding_worker(tmp_path, level)
+    try:
+        with pytest.raises(SandboxError, match=r"more than 160 MiB of memory across its processes"):
+            worker.call("hoarders", "deleted", (2, 100, 3.0), {})
     finally:
         worker.close()
 

@@ -318,3 +318,27 @@ def test_the_mapped_files_name_the_forbidden_package_a_process_holds():
         assert mappings.violation([holder.pid], ()) is None  # lecture 1's modules may hold it
     finally:
         holder.communicate("")
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the uid mode needs root")
+def test_the_rules_uid_finds_nothing_the_slots_other_uid_left(tmp_path):
+    """pca.py (the slot's uid, which may read scipy.spatial) could copy it to /tmp for nn.py (the
+    slot's second uid, barred from it): the other uid's files are removed before the switch."""
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "pca.py").write_text(
+        "import os\n\ndef leave(name):\n"
+        "    with open(name, 'w') as handle:\n        handle.write('copy')\n"
+        "    os.chmod(name, 0o644)\n    return 1\n"
+    )
+    (package / "nn.py").write_text("import os\n\ndef find(name):\n    return int(os.path.exists(name))\n")
+    impl = Worker(stage(package).root, timeout=20, level=Isolation(UID, reserve_uid(), "test"))
+    name = f"/tmp/left-by-pca-{os.getpid()}"
+    try:
+        assert impl.call("pca", "leave", (name,), {}) == 1
+        assert impl.call("nn", "find", (name,), {}) == 0
+    finally:
+        impl.close()
+        if os.path.exists(name):
+            os.unlink(name)
