@@ -36,15 +36,17 @@ answers right:
   rule's depth-first order and nearer in cell distance (so before it in
   best-bin-first order too), p an answer point of B, u a point of A farther
   than d_k. Compare a lawful search on the trapped tree with the same search
-  on the true tree. While the true search has read A but not B, the trapped
-  one holds p where the true one holds u, and p ranks before u; otherwise
-  both have read the same points. Swapping a held point for one that ranks
-  before it never raises the k-th held (s, index), so the trapped search's
-  w is at most the true one's at every step; every pruning test (plane,
-  cell, best-bin-first's stop, the octree's early termination) only prunes
-  more with a smaller w, so it reads a subset of what the true search reads
-  (and never a decoy), and what it skips is strictly beyond its w, so its
-  answer is the true one. The BST is the same argument with one key per
+  on the true tree, step by step (induction). The trapped search reads a
+  subset of the leaves the true one reads; the points of the leaves it
+  skipped lay strictly beyond its w when skipped, and w only decreases; and
+  between A and B it holds p where the true one holds u, p ranking before u.
+  So at every step the true search's k-th held (s, index) ranks no earlier
+  than the trapped one's: the trapped w is at most the true w (once pruning
+  differs, the two read different points, so comparing the held sets alone
+  would not do). Every pruning test (plane, cell, best-bin-first's stop,
+  the octree's early termination) only prunes more with a smaller w, which
+  keeps the subset; so it never reads a decoy, and what it skips is
+  strictly beyond its w, so its answer is the true one. The BST is the same argument with one key per
   node: only the keys of childless nodes are swapped (a key elsewhere routes
   the search), B's key nearer than A's.
 
