@@ -29,6 +29,8 @@ library the submission carries as data in its source and writes out itself
 this module does not claim to stop.
 """
 
+import os
+import re
 import shutil
 from functools import cache
 from pathlib import Path
@@ -79,19 +81,27 @@ def _sandbox_prefixes():
     return tuple((f"{str(host).rstrip('/')}/", f"{inside.rstrip('/')}/") for host, inside in sandbox_roots())
 
 
+_MAPPING = re.compile(rb"^\S+ \S\S(\S)\S \S+ \S+ [1-9]\d* +(/[^\n]*)$", re.MULTILINE)  # perms' x, a file's path
+
+
 def mapped_files(pid):
     """{path: executable} of every file ``pid`` has mapped, from ``/proc/PID/maps``
-    (empty if the process is gone)."""
+    (empty if the process is gone). Read after every call: one read, one regular expression
+    (anonymous mappings have inode 0, and are skipped by it)."""
     try:
-        with open(f"/proc/{pid}/maps", encoding="utf-8", errors="surrogateescape") as maps:
-            lines = maps.read().splitlines()
-    except (OSError, ValueError):
+        handle = os.open(f"/proc/{pid}/maps", os.O_RDONLY)
+        try:
+            chunks = []
+            while chunk := os.read(handle, 1 << 16):
+                chunks.append(chunk)
+        finally:
+            os.close(handle)
+    except OSError:
         return {}
     files = {}
-    for line in lines:
-        fields = line.split(None, 5)
-        if len(fields) == 6 and fields[5][:1] == "/":
-            files[fields[5]] = files.get(fields[5], False) or "x" in fields[1]
+    for executable, path in _MAPPING.findall(b"".join(chunks)):
+        name = os.fsdecode(path)
+        files[name] = files.get(name, False) or executable == b"x"
     return files
 
 
