@@ -74,6 +74,11 @@ DIAGNOSIS_MAX_VALUES = 2_000_000
 # (grading/recording.py, Recorder): calls past it are recorded without them. The
 # reference's whole grading (both lectures) keeps 21 MB (measured, see the README).
 DIAGNOSIS_BUDGET = 64 * 1024**2
+# Bytes of answers a grading receives between two collections of Python's reference cycles:
+# a failed test's traceback holds its frames, and the answers in them, until the cycle
+# collector runs, which counts objects, not bytes (a run of large answers, each failing,
+# took the grading process from 0.86 to 1.4 GiB by the collector's timing alone).
+COLLECT_EVERY_BYTES = 64 * 1024**2
 # Wall-clock seconds of one submission's whole grading: tests not started by
 # then score 0 with a line that says so (a test under way may add its own
 # TEST_TIMEOUT), within Gradescope's default limit of 10 minutes.

@@ -220,6 +220,7 @@ class Implementation:
         def graded_call(*args, **kwargs):
             self.last_call = describe_call(name, args, kwargs)
             self.last_modified, modified = [], []
+            self.recorder.collect_if_due()
             kept = self.recorder.snapshot(args, kwargs)
             call = Call(self.current_test, *(kept[0] if kept else ((), {})), kept=kept is not None)
             self.calls.setdefault(name, []).append(call)
@@ -237,6 +238,7 @@ class Implementation:
             finally:
                 self.last_modified = argument_names(name, modified)
                 call.modified = bool(self.last_modified)
+            self.recorder.received_answer(result)
             fits, copied = self.recorder.keep_result(result) if kept is not None else (False, None)
             if fits:
                 call.result = copied

@@ -2,6 +2,7 @@
 byte budget for the whole grading (:data:`grading.config.DIAGNOSIS_BUDGET`)."""
 
 import copy
+import gc
 
 import numpy as np
 
@@ -47,6 +48,7 @@ class Recorder:
     def __init__(self, budget=None):
         self.budget = config.DIAGNOSIS_BUDGET if budget is None else budget
         self.used = 0  # bytes of the copies kept so far
+        self.received = 0  # bytes of answers since the last collection of reference cycles
 
     def snapshot(self, args, kwargs):
         """Copies of a call's arguments and their cost in bytes, or None when they do not fit."""
@@ -58,6 +60,18 @@ class Recorder:
             self.used += cost
             return kept, cost
         return None
+
+    def received_answer(self, result):
+        """Count an answer's bytes toward the next collection of reference cycles (:meth:`collect_if_due`)."""
+        self.received += bytes_of(result)
+
+    def collect_if_due(self):
+        """Collect reference cycles once :data:`config.COLLECT_EVERY_BYTES` of answers came in since
+        the last time, so that the answers failed tests' tracebacks hold are freed by bytes, not by
+        object counts (:func:`gc.collect` costs milliseconds; calls answering small arrays never pay it)."""
+        if self.received > config.COLLECT_EVERY_BYTES:
+            self.received = 0
+            gc.collect()
 
     def keep_result(self, result):
         """(True, a copy of a call's answer) if it fits (its cost counted), else (False, None)."""

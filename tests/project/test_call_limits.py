@@ -288,6 +288,36 @@ def test_what_a_grading_keeps_for_the_diagnosis_is_bounded_as_a_whole(tmp_path, 
     assert all(c.result is None and c.args == () for c in calls if not c.kept)
 
 
+def test_answers_held_by_reference_cycles_are_freed_by_bytes_not_object_counts(tmp_path, monkeypatch):
+    """A failed test's traceback holds its frames, and the answers in them, in a reference cycle:
+    Python's collector, which counts objects, let such answers pile up (0.86 or 1.4 GiB for one
+    grading, by its timing alone). The grading collects once enough answer bytes came in."""
+    import gc
+    import weakref
+
+    from grading.implementation import Implementation
+
+    monkeypatch.setattr(config, "COLLECT_EVERY_BYTES", 4 * 2**20, raising=False)
+    package = tmp_path / "pcl_course"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "pca.py").write_text(LARGE_ANSWERS)
+    impl = Implementation(package)
+    points = np.random.default_rng(0).normal(size=(200, 3))
+    answers = []
+    gc.disable()  # only the grading's own collections run
+    try:
+        for _ in range(40):  # 32 MB of answers in all, 0.8 MB each
+            cycle = [impl.pca(points)[0]]
+            cycle.append(cycle)  # held by nothing but itself, as a failed test's frames are
+            answers.append(weakref.ref(cycle[0]))
+            del cycle
+        alive = sum(answer() is not None for answer in answers)
+    finally:
+        gc.enable()
+    assert alive <= 4 * 2**20 / 800_000 + 2, f"{alive} of 40 answers held by cycles still alive"
+
+
 PEAK_PLUGIN = """
 def pytest_unconfigure(config):
     with open(PEAK, "w") as handle:
