@@ -190,11 +190,21 @@ def test_a_generator_comes_back_only_on_its_own_stream(tmp_path, level):
 # -- a bounded protocol ------------------------------------------------------------------------------
 
 # Each function writes one hostile answer straight to the protocol's pipe (the worker's
-# private copy of its stdout, the first descriptor after stderr), then waits to be killed.
+# private copy of its stdout: the first pipe after stderr; where the call's arguments'
+# memfd lands before it depends on the sandbox), then waits to be killed.
 FRAMES = """
-import json, os, struct, sys, time, zlib, io, zipfile
+import json, os, stat, struct, sys, time, zlib, io, zipfile
 MAGIC = b"PCLW"
-OUT = 3
+
+
+def _is_pipe(fd):
+    try:
+        return stat.S_ISFIFO(os.fstat(fd).st_mode)
+    except OSError:
+        return False
+
+
+OUT = next(fd for fd in range(3, 64) if _is_pipe(fd))
 
 
 def _frame(payload):
