@@ -230,6 +230,24 @@ def check_octree(tree, points, leaf_size, min_extent):
         _fail(f"the tree has {m_nodes} nodes, {expected_next[0]} are reachable from the root", "unreachable nodes")
 
 
+def _around(got, expected, width=3):
+    """Where two neighbour rows first part, and their entries around it: ``got [..., a, b, ...]``.
+
+    A row's first entries are often right (a wrong pruning loses a far
+    neighbour, a strict test the k-th of a tie), so the evidence is the
+    neighbourhood of the first difference, not the row's head.
+    """
+    got, expected = np.asarray(got).tolist(), np.asarray(expected).tolist()
+    position = next((j for j, (a, b) in enumerate(zip(got, expected)) if a != b), min(len(got), len(expected)))
+    first, last = max(0, position - width), position + width + 1
+
+    def shown(row):
+        inner = ", ".join(str(v) for v in row[first:last])
+        return "[" + ("..., " if first else "") + inner + (", ..." if last < len(row) else "") + "]"
+
+    return f"position {position} (of {len(expected)}) first differs: got {shown(got)}, expected {shown(expected)}"
+
+
 def check_knn(indices, distances, expected_indices, expected_distances, what="kNN"):
     """Neighbour rows equal to brute force's, ties by the lower index."""
     check_array(indices, "indices", shape=expected_indices.shape, dtype="int64")
@@ -245,8 +263,8 @@ def check_knn(indices, distances, expected_indices, expected_distances, what="kN
             "(the lower index wins, at the k-th place too)"
         )
         _fail(
-            f"{what}: {len(wrong)} of {len(indices)} rows differ from brute force; row {row}: got "
-            f"{indices[row][:8]}, expected {expected_indices[row][:8]}\n  hint: {hint}",
+            f"{what}: {len(wrong)} of {len(indices)} rows differ from brute force; row {row}: "
+            f"{_around(indices[row], expected_indices[row])}\n  hint: {hint}",
             f"{what}: rows differ from brute force",
         )
     if not np.allclose(distances, expected_distances, rtol=1e-9, atol=1e-12):
@@ -275,8 +293,8 @@ def check_csr(result, expected_rows, what="radius search"):
             else:
                 hint = "extra points: keep only those with squared distance <= radius ** 2"
             _fail(
-                f"{what}: query {i}: got {len(got)} neighbours {got[:6]}, expected {len(rows)} {rows[:6]} "
-                f"({total} in all)\n  hint: {hint}",
+                f"{what}: query {i}: got {len(got)} neighbours, expected {len(rows)} ({total} in all); "
+                f"{_around(got, rows)}\n  hint: {hint}",
                 f"{what}: rows differ from brute force",
             )
         if not np.allclose(distances[indptr[i] : indptr[i + 1]], dists, rtol=1e-9, atol=1e-12):

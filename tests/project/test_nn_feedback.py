@@ -1,0 +1,46 @@
+"""What lecture 2's feedback shows a student (issue 36): the evidence of a failure, not a restatement.
+
+Each test here feeds one check the answer of a mistake students make and
+reads the text the student would read.
+"""
+
+import numpy as np
+import pytest
+
+from grading.checks.nn import check_csr, check_knn
+from grading.errors import CheckFailed
+
+
+def failure(check, *args):
+    with pytest.raises(CheckFailed) as caught:
+        check(*args)
+    return str(caught.value)
+
+
+def test_a_knn_row_that_differs_late_shows_where_it_differs():
+    # A strict pruning test at k = 19 loses the 19th neighbour only: the row's first 8 columns are
+    # right, and a message showing them printed identical "got" and "expected" rows.
+    expected = np.tile(np.arange(19), (3, 1))
+    got = expected.copy()
+    got[1, 18] = 40
+    distances = np.zeros((3, 19))
+    text = failure(check_knn, got, distances, expected, distances, "octree_knn, k=19")
+    assert "1 of 3 rows differ" in text and "row 1" in text
+    assert "position 18 (of 19)" in text
+    assert "got [..., 15, 16, 17, 40], expected [..., 15, 16, 17, 18]" in text
+
+
+def test_a_radius_row_that_differs_late_shows_where_it_differs():
+    rows = [(np.arange(30), np.linspace(0, 1, 30))]
+    got_indices = np.r_[np.arange(29), 77]
+    result = (np.array([0, 30]), got_indices, np.linspace(0, 1, 30))
+    text = failure(check_csr, result, rows)
+    assert "query 0: got 30 neighbours, expected 30" in text
+    assert "position 29 (of 30)" in text and "got [..., 26, 27, 28, 77], expected [..., 26, 27, 28, 29]" in text
+
+
+def test_a_short_row_shows_where_it_ends():
+    rows = [(np.arange(5), np.zeros(5))]
+    result = (np.array([0, 3]), np.arange(3), np.zeros(3))
+    text = failure(check_csr, result, rows)
+    assert "got 3 neighbours, expected 5" in text and "position 3 (of 5)" in text
