@@ -44,3 +44,13 @@ def test_a_short_row_shows_where_it_ends():
     result = (np.array([0, 3]), np.arange(3), np.zeros(3))
     text = failure(check_csr, result, rows)
     assert "got 3 neighbours, expected 5" in text and "position 3 (of 5)" in text
+
+
+def test_lecture_2s_tests_are_numbered_within_their_own_assignment(tmp_path):
+    # Gradescope shows "1.1 ..." for lecture 1's first test; lecture 2's started at 18.1 (a global index).
+    from _helpers import run_grader
+
+    summary, _ = run_grader("--reference", "--function", "knn_result_set", "--function", "bst_build", tmp_path=tmp_path)
+    numbers = {test["number"].split(".")[0] for test in summary["tests"]}
+    names = {test["number"].split(".")[0]: test["tags"][0] for test in summary["tests"]}
+    assert numbers == {"1", "2"} and names == {"1": "knn_result_set", "2": "bst_build"}, names
