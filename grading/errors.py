@@ -30,6 +30,18 @@ class StagingError(Exception):
     code, too many or too large files, ...)."""
 
 
+class NothingToGrade(StagingError):
+    """The submission holds none of the assignment's exercise modules (an empty upload, or
+    another lecture's files): not refused, there is just nothing to grade."""
+
+    def __init__(self, modules):
+        self.modules = tuple(modules)
+        expected = ", ".join(f"{m}.py" for m in self.modules)
+        super().__init__(
+            f"nothing to grade (expected {expected}): upload your repository, its pcl_course/ folder, or {expected}"
+        )
+
+
 class CheckFailed(AssertionError):
     """A graded check failed (raised by :mod:`grading.checks`).
 

@@ -24,7 +24,7 @@ from pathlib import Path
 import yaml
 
 from grading import ASSIGNMENTS, config
-from grading.errors import StagingError
+from grading.errors import NothingToGrade, StagingError
 from grading.instructors.gradebook import write_gradebook
 from grading.instructors.gradescope import assemble
 from grading.instructors.reports import csv_report, say
@@ -299,6 +299,9 @@ def batch(args):
         with tempfile.TemporaryDirectory(prefix="batch-", dir=out) as work:
             try:
                 package, folder.note = assemble(entry, work, args.assignment)
+            except NothingToGrade as exc:
+                folder.status, folder.note = "not graded", str(exc)
+                return folder, ""
             except StagingError as exc:
                 folder.status, folder.note = "not graded", f"refused: {exc}"
                 return folder, ""

@@ -34,7 +34,7 @@ from pathlib import Path
 
 from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, EXERCISE_MODULES, REPO_ROOT
 from grading.config import MAX_TEXT
-from grading.errors import StagingError
+from grading.errors import NothingToGrade, StagingError
 from grading.instructors.leakcheck import find_leaks
 from grading.instructors.reports import say
 from grading.instructors.shipping import IGNORED, cut_reference_link
@@ -232,7 +232,7 @@ class Assembled:
     ignored: list = field(default_factory=list)
 
 
-def lay_over_stubs(submission, into):
+def lay_over_stubs(submission, into, modules=EXERCISE_MODULES):
     """Lay the submission's code over a pristine ``pcl_course/`` in ``into``.
 
     The one reading of a submission's layout: ``assemble`` (Gradescope's
@@ -241,14 +241,18 @@ def lay_over_stubs(submission, into):
     link followed, with caps): a link, a device or compiled code refuses the
     whole submission.
 
+    ``modules`` are the exercise modules looked for, named when none is found.
+
     Returns
     -------
     Assembled
 
     Raises
     ------
+    NothingToGrade
+        When no exercise module was found (a :class:`StagingError`).
     StagingError
-        When nothing gradable was found, or the submission cannot be staged.
+        When the submission cannot be staged.
     """
     submission = Path(submission)
     located = locate(submission)
@@ -270,11 +274,7 @@ def lay_over_stubs(submission, into):
         where = "the uploaded files" if where == ["."] else ", ".join(f"{w}/" for w in where)
         found = list(located.modules)
     else:
-        expected = ", ".join(f"{m}.py" for m in EXERCISE_MODULES)
-        raise StagingError(
-            f"no pcl_course/ folder and none of {expected} in the submission: "
-            "upload your repository, its pcl_course/ folder, or those files"
-        )
+        raise NothingToGrade(modules)
     return Assembled(package, found, where, located.ignored)
 
 
@@ -293,18 +293,18 @@ def assemble(submission, into, assignment=None):
 
     Raises
     ------
+    NothingToGrade
+        When none of the assignment's modules was found (another lecture's files only, or none).
     StagingError
-        When nothing gradable was found, or the submission cannot be staged.
+        When the submission cannot be staged.
     """
     graded = ASSIGNMENT_MODULES[assignment] if assignment else EXERCISE_MODULES
-    assembled = lay_over_stubs(submission, into)
+    assembled = lay_over_stubs(submission, into, graded)
     found = [m for m in assembled.found if m in graded]
+    if not found:
+        raise NothingToGrade(graded)
     missing = [m for m in graded if m not in found]
-    note = (
-        f"Graded from {assembled.where}: "
-        + (", ".join(f"`{m}.py`" for m in found) or "none of this assignment's modules")
-        + "."
-    )
+    note = f"Graded from {assembled.where}: " + ", ".join(f"`{m}.py`" for m in found) + "."
     if missing:
         note += " Missing (graded as the course's stub, 0 points): " + ", ".join(f"`{m}.py`" for m in missing) + "."
     if assembled.ignored:
@@ -374,7 +374,7 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
         try:
             package, note = assemble(root / "submission", work, assignment)
         except StagingError as exc:
-            message = f"submission refused: {exc}"
+            message = str(exc) if isinstance(exc, NothingToGrade) else f"submission refused: {exc}"
             _write_json(results, _failure_results(message, started))
             say(message)  # names the submission's files: escaped, as every text a student chose
             return 0

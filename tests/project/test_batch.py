@@ -124,7 +124,8 @@ def test_batch_accounts_for_every_folder_in_five_layouts(tmp_path):
     assert set(rows) == {"alice01", "empty02", "loose03", "submission_31415926", "eve05"}
     full = rows["alice01"]["max_score"]
     assert rows["alice01"]["status"] == "graded" and rows["alice01"]["score"] == full != "0"
-    assert rows["empty02"]["status"] == "not graded" and "no pcl_course/ folder" in rows["empty02"]["note"]
+    assert rows["empty02"]["status"] == "not graded"
+    assert rows["empty02"]["note"].startswith("nothing to grade (expected")
     assert (
         rows["loose03"]["score"] == full
         and "Not graded (not exercise modules): `helper_notes.py`" in rows["loose03"]["note"]
@@ -143,3 +144,20 @@ def test_batch_accounts_for_every_folder_in_five_layouts(tmp_path):
         "eve05": "0",
         "frank06": "",
     }
+
+
+def test_a_folder_with_nothing_of_the_assignment_is_nothing_to_grade_and_names_its_modules(tmp_path):
+    # A lecture-2 batch told an empty folder "refused: ..." and listed lecture 1's modules.
+    import pytest
+
+    from grading.errors import NothingToGrade
+    from grading.instructors.gradescope import assemble
+
+    empty, lecture1 = tmp_path / "empty", tmp_path / "lecture1_only"
+    empty.mkdir()
+    lecture1.mkdir()
+    (lecture1 / "pca.py").write_text("def pca(points):\n    return None\n")
+    for folder in (empty, lecture1):
+        with pytest.raises(NothingToGrade) as caught:
+            assemble(folder, tmp_path / f"work-{folder.name}", "lecture2")
+        assert str(caught.value).startswith("nothing to grade (expected nn.py): "), str(caught.value)

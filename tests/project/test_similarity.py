@@ -221,7 +221,7 @@ def test_every_layout_graded_is_compared_as_python_decodes_it_and_every_entry_le
     assert len(skipped) == 4, skipped
     assert skipped[0].startswith("erin: pca.py not compared: its bytes cannot be decoded as Python decodes them")
     assert skipped[1] == "frank.txt: not compared: not a folder (a link or a file)"
-    assert skipped[2].startswith("gina: not compared: no pcl_course/ folder and none of pca.py")
+    assert skipped[2].startswith("gina: not compared: nothing to grade (expected pca.py, ")
     assert skipped[3] == "ivan: pca/ is a package: only its __init__.py compared"
 
 
