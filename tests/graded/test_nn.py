@@ -105,14 +105,21 @@ def oc_tree(impl, points, leaf_size, min_extent=1e-3):
 # -- knn_result_set -----------------------------------------------------------------------------
 
 
+def check_result_set(indices, distances, worst, held, offered):
+    """The three arrays' types and shapes first: what a student reads when they are lists, not a
+    test's own ``AttributeError``."""
+    check_array(indices, "indices", shape=(held,), dtype="int64")
+    check_array(distances, "distances", shape=(held,))
+    check_array(worst, "worst", shape=(offered,))
+
+
 @pytest.mark.grades("knn_result_set")
 @pytest.mark.points(2)
 def test_knn_result_set_hand_worked(impl):
     # Offers (3, 10), (1, 11), (2, 12), (1, 9) to k = 2: (2, 12) evicts (3, 10); (1, 9) evicts (2, 12)
     # because (1, 9) < (2, 12); it also goes before (1, 11), on the index.
     indices, distances, worst = impl.knn_result_set(np.array([3.0, 1.0, 2.0, 1.0]), np.array([10, 11, 12, 9]), 2)
-    check_array(indices, "indices", shape=(2,), dtype="int64")
-    check_array(worst, "worst", shape=(4,))
+    check_result_set(indices, distances, worst, 2, 4)
     assert indices.tolist() == [9, 11], f"expected [9, 11] (ties by the lower index), got {indices.tolist()}"
     assert distances.tolist() == [1.0, 1.0]
     assert worst.tolist() == [np.inf, 3.0, 2.0, 1.0], f"worst after each offer: expected [inf, 3, 2, 1], got {worst}"
@@ -126,6 +133,7 @@ def test_knn_result_set_matches_sorting_with_ties(impl):
         distances = rng.integers(0, 8, n).astype(float) / 4  # many ties
         indices = rng.permutation(1000)[:n]
         got_indices, got_distances, worst = impl.knn_result_set(distances, indices, k)
+        check_result_set(got_indices, got_distances, worst, min(n, k), n)
         rank = np.lexsort((indices, distances))[:k]
         assert got_indices.tolist() == indices[rank].tolist(), (
             f"n={n}, k={k}: expected the k smallest (distance, index) pairs, ascending; the lower index wins ties"
@@ -139,6 +147,7 @@ def test_knn_result_set_matches_sorting_with_ties(impl):
 @pytest.mark.points(1)
 def test_knn_result_set_with_fewer_candidates_than_k_is_not_padded(impl):
     indices, distances, worst = impl.knn_result_set(np.array([0.5, 0.25]), np.array([4, 2]), 5)
+    check_result_set(indices, distances, worst, 2, 2)
     assert indices.tolist() == [2, 4] and distances.tolist() == [0.25, 0.5], "fewer than k: return them all, sorted"
     assert np.all(np.isinf(worst)), "worst is inf while fewer than k are held"
     empty = impl.knn_result_set(np.empty(0), np.empty(0, dtype=np.int64), 3)
@@ -191,8 +200,10 @@ def test_bst_build_inserts_in_order_with_duplicates(impl):
 def test_bst_build_of_sorted_keys_is_a_path(impl):
     keys = np.arange(1500.0)  # depth 1499: beyond Python's recursion limit
     left, right = impl.bst_build(keys)
+    check_array(left, "left", shape=(1500,), dtype="int64")
+    check_array(right, "right", shape=(1500,), dtype="int64")
     assert np.all(left == -1) and right.tolist() == [*range(1, 1500), -1], (
-        "sorted keys make a path of right children; build it with a loop, not one recursive call per level"
+        "sorted keys make a path of right children: every left is -1 and right[j] = j + 1"
     )
 
 

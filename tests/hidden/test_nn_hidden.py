@@ -26,6 +26,7 @@ drops every decoy too) loses an answer point, and is told so.
 import numpy as np
 import pytest
 
+from grading.checks import check_array
 from grading.checks.nn import check_csr, check_kdtree, check_knn, check_octree
 from grading.errors import CheckFailed
 from grading.instructors import lying_trees, trees
@@ -98,6 +99,8 @@ def test_knn_result_set_hidden_ties_at_the_kth_place_and_large_distances(impl):
     distances = np.array([5.0, 2.0, 2.0, 7.0, 2.0, 1e12, 3e11])
     indices = np.array([40, 31, 12, 9, 30, 1, 2])
     got, got_distances, worst = impl.knn_result_set(distances, indices, 3)
+    check_array(got, "indices", shape=(3,), dtype="int64")
+    check_array(worst, "worst", shape=(7,))
     rank = np.lexsort((indices, distances))[:3]
     assert got.tolist() == indices[rank].tolist(), "ties at the k-th place: the lower index stays"
     got, _, worst = impl.knn_result_set(distances[5:], indices[5:], 1)
@@ -109,6 +112,8 @@ def test_knn_result_set_hidden_ties_at_the_kth_place_and_large_distances(impl):
 def test_bst_build_hidden_many_equal_keys(impl):
     keys = np.array([2.0] * 30 + [1.0] * 10 + [3.0] * 10)
     left, right = impl.bst_build(keys)
+    check_array(left, "left", shape=(50,), dtype="int64")
+    check_array(right, "right", shape=(50,), dtype="int64")
     expected = trees.bst(keys)
     assert left.tolist() == expected[0].tolist() and right.tolist() == expected[1].tolist(), "equal keys go right"
 

@@ -54,3 +54,34 @@ def test_lecture_2s_tests_are_numbered_within_their_own_assignment(tmp_path):
     numbers = {test["number"].split(".")[0] for test in summary["tests"]}
     names = {test["number"].split(".")[0]: test["tags"][0] for test in summary["tests"]}
     assert numbers == {"1", "2"} and names == {"1": "knn_result_set", "2": "bst_build"}, names
+
+
+LISTS = '''
+from solutions.nn import *  # noqa: F401,F403
+from solutions.nn import bst_build as _build, knn_result_set as _result_set
+
+
+def bst_build(keys):
+    left, right = _build(keys)
+    return left.tolist(), right.tolist()
+
+
+def knn_result_set(distances, indices, k):
+    return tuple(a.tolist() for a in _result_set(distances, indices, k))
+'''
+
+
+def test_lists_for_arrays_are_named_in_every_test_not_hidden_behind_the_tests_own_errors(tmp_path):
+    # Lists were told "build it with a loop, not one recursive call per level" (list == -1 is False),
+    # or shown the test's own "'list' object has no attribute 'tolist'".
+    from _helpers import run_grader
+
+    module = tmp_path / "nn.py"
+    module.write_text(LISTS)
+    arguments = ("--reference", "--impl-module", f"nn={module}", "--function", "bst_build")
+    summary, _ = run_grader(*arguments, "--function", "knn_result_set", tmp_path=tmp_path)
+    public = [t for t in summary["tests"] if t["visibility"] == "visible" and t["status"] == "failed"]
+    assert len(public) >= 6
+    for test in public:
+        assert "must be a plain numpy.ndarray, got builtins.list" in test["text"], test["text"]
+        assert "tolist" not in test["text"] and "recursive call" not in test["text"], test["text"]
