@@ -85,3 +85,23 @@ def test_lists_for_arrays_are_named_in_every_test_not_hidden_behind_the_tests_ow
     for test in public:
         assert "must be a plain numpy.ndarray, got builtins.list" in test["text"], test["text"]
         assert "tolist" not in test["text"] and "recursive call" not in test["text"], test["text"]
+
+
+def test_a_bst_search_run_locally_on_a_broken_build_says_so(monkeypatch):
+    # In the student release the searches run on the student's own builds: the k-d and octree
+    # tests said so, the BST's did not (a cycle in the links showed as a RecursionError in bst_knn).
+    import importlib
+    import types
+
+    graded = importlib.import_module("tests.graded.test_nn")
+    monkeypatch.setattr(graded, "grader_trees", None)  # as in the student release
+
+    def bst_build(keys):
+        left, right = np.full(len(keys), -1), np.full(len(keys), -1)
+        right[:-1] = np.arange(1, len(keys))
+        right[-1] = 0  # a cycle back to the root
+        return left, right
+
+    with pytest.raises(AssertionError) as caught:
+        graded.bst_of(types.SimpleNamespace(bst_build=bst_build), np.arange(5.0))
+    assert str(caught.value).startswith("locally this search runs on your own bst_build, which is wrong: ")
