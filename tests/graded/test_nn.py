@@ -461,9 +461,18 @@ def test_octree_build_hand_worked(impl):
     assert np.asarray(tree["children"][0]).tolist() == [1, -1, -1, -1, -1, -1, -1, 4], (
         f"root's children: expected [1, -1, ..., -1, 4], got {tree['children'][0]}"
     )
-    assert np.asarray(tree["extent"]).tolist() == [1.0, 0.5, 0.25, 0.25, 0.5]
-    assert np.asarray(tree["order"]).tolist() == [0, 2, 1]
-    assert np.asarray(tree["center"][3]).tolist() == [0.75, 0.25, 0.25]
+    extent = np.asarray(tree["extent"]).tolist()
+    assert extent == [1.0, 0.5, 0.25, 0.25, 0.5], (
+        f"extent (half the side of each node's cube, nodes in preorder): expected [1, 0.5, 0.25, 0.25, 0.5], got "
+        f"{extent}: the root's is half the bounding cube's side, each child's half its parent's"
+    )
+    order = np.asarray(tree["order"]).tolist()
+    assert order == [0, 2, 1], f"order: expected [0, 2, 1] (the leaves' points in preorder), got {order}"
+    center = np.asarray(tree["center"][3]).tolist()
+    assert center == [0.75, 0.25, 0.25], (
+        f"center of node 3 (code 1 under node 1): expected [0.75, 0.25, 0.25], got {center}: a child's centre "
+        "is its parent's plus or minus half the parent's extent on each axis, + where its code's bit is 1"
+    )
 
 
 @pytest.mark.grades("octree_build")

@@ -56,7 +56,7 @@ def test_lecture_2s_tests_are_numbered_within_their_own_assignment(tmp_path):
     assert numbers == {"1", "2"} and names == {"1": "knn_result_set", "2": "bst_build"}, names
 
 
-LISTS = '''
+LISTS = """
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import bst_build as _build, knn_result_set as _result_set
 
@@ -68,7 +68,7 @@ def bst_build(keys):
 
 def knn_result_set(distances, indices, k):
     return tuple(a.tolist() for a in _result_set(distances, indices, k))
-'''
+"""
 
 
 def test_lists_for_arrays_are_named_in_every_test_not_hidden_behind_the_tests_own_errors(tmp_path):
@@ -105,3 +105,22 @@ def test_a_bst_search_run_locally_on_a_broken_build_says_so(monkeypatch):
     with pytest.raises(AssertionError) as caught:
         graded.bst_of(types.SimpleNamespace(bst_build=bst_build), np.arange(5.0))
     assert str(caught.value).startswith("locally this search runs on your own bst_build, which is wrong: ")
+
+
+def test_the_hand_worked_octree_names_the_field_that_differs(tmp_path):
+    # A build whose extents were the full side failed with a bare pytest diff, never naming extent.
+    from _helpers import run_grader
+
+    module = tmp_path / "nn.py"
+    module.write_text(
+        "from solutions.nn import *  # noqa: F401,F403\n"
+        "from solutions.nn import octree_build as _build\n\n\n"
+        "def octree_build(points, leaf_size=8, min_extent=1e-3):\n"
+        "    tree = _build(points, leaf_size, min_extent)\n"
+        "    return dict(tree, extent=2 * tree['extent'])\n"
+    )
+    arguments = ("--reference", "--impl-module", f"nn={module}", "-k", "test_octree_build_hand_worked")
+    summary, _ = run_grader(*arguments, tmp_path=tmp_path)
+    (test,) = summary["tests"]
+    assert test["status"] == "failed" and "extent (half the side of each node's cube" in test["text"], test["text"]
+    assert "Use -v" not in test["text"]
