@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, config
+from grading.checks import UNNAMED_ARGUMENT
 from grading.forbidden import scan_source
 
 # Kinds of test failure, recorded by the plugin for each failed test.
@@ -318,10 +319,18 @@ def _did_not_raise(function, calls, outcomes, failed, context):
     return None
 
 
-def _one_rule(function, calls, outcomes, failed, context):
-    rules = {outcomes[t].rule for t in failed}
-    if len(failed) >= 2 and len(rules) == 1 and None not in rules and all(outcomes[t].kind == CHECK for t in failed):
-        return Diagnosis("one_rule", f"every failed test breaks one rule: {rules.pop()}", tuple(failed))
+def _names_another_argument(function, calls, outcomes, failed, context):
+    """Every failed test is an input check whose ValueError names another argument than the bad one
+    (``qs`` for ``queries``): the check is there, its message is not the contract's."""
+    rules = [outcomes[t].rule or "" for t in failed]
+    if failed and all(rule.startswith(UNNAMED_ARGUMENT) for rule in rules):
+        names = sorted({rule[len(UNNAMED_ARGUMENT) :].strip(" ,") for rule in rules})
+        return Diagnosis(
+            "names_another_argument",
+            f"{function} checks its input, but its ValueError must name the bad argument as the contract "
+            f"does: {', '.join(names)}",
+            tuple(failed),
+        )
     return None
 
 
@@ -513,8 +522,8 @@ FINDINGS = (
     _modified_input,
     _result_type,
     _known_mistake,
+    _names_another_argument,
     _did_not_raise,
-    _one_rule,
 )
 
 

@@ -144,6 +144,17 @@ def check_unmodified(impl, function):
         )
 
 
+# The rule of a ValueError that does not name the bad argument (``raises(..., naming=...)``),
+# followed by the argument's name: the diagnosis reads it (grading/diagnosis.py).
+UNNAMED_ARGUMENT = "the error does not name the bad argument"
+
+
+def _clipped(text, limit=200):
+    """The first line of ``text``, at most ``limit`` characters."""
+    line = (text.splitlines() or [""])[0]
+    return line if len(line) <= limit else line[: limit - 3] + "..."
+
+
 class raises:
     """``with raises(ValueError) as caught:`` -- the call inside must raise ``expected``.
 
@@ -151,11 +162,14 @@ class raises:
     :class:`grading.errors.DidNotRaise`: the grader knows that verdict by its
     class, not by the words of pytest's message. Another exception passes
     through (the submission's error, shown as such); ``caught.value`` is
-    the exception raised.
+    the exception raised. ``naming``: the message must contain this
+    argument's name, or the check fails with a line that says which
+    argument and what the message was (not pytest's introspection).
     """
 
-    def __init__(self, expected):
+    def __init__(self, expected, naming=None):
         self.expected = expected
+        self.naming = naming
         self.value = None
 
     def __enter__(self):
@@ -170,5 +184,11 @@ class raises:
             )
         if issubclass(kind, self.expected):
             self.value = value
+            if self.naming is not None and self.naming not in str(value):
+                raise CheckFailed(
+                    f"the {kind.__name__} must name the bad argument, {self.naming!r}; its message was: "
+                    f"{_clipped(str(value))!r}",
+                    rule=f"{UNNAMED_ARGUMENT}, {self.naming!r}",
+                ) from None
             return True
         return False

@@ -188,9 +188,8 @@ def test_voxel_grid_downsample_empty_cloud(impl):
 @pytest.mark.interface
 def test_voxel_grid_downsample_rejects_bad_input(impl, kwargs, name):
     arguments = {"points": np.random.default_rng(33).uniform(size=(10, 3)), "voxel_size": 0.5, **kwargs}
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming=name):
         impl.voxel_grid_downsample(**arguments)
-    assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"
 
 
 # --- approximate_voxel_downsample ---------------------------------------------------
@@ -299,9 +298,8 @@ def test_approximate_voxel_downsample_rejects_bad_input(impl):
         ({"method": "mode"}, "method"),
     ):
         arguments = {"points": points, "voxel_size": 0.5, "n_containers": 10, **kwargs}
-        with raises(ValueError) as excinfo:
+        with raises(ValueError, naming=name):
             impl.approximate_voxel_downsample(**arguments)
-        assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"
 
 
 # --- farthest_point_sampling -------------------------------------------------------------
@@ -449,9 +447,8 @@ def test_farthest_point_sampling_rejects_bad_arguments(impl, cloud):
         ({"start_index": 3000}, "start_index"),
     ):
         arguments = {"points": cloud, "n_samples": 5, **kwargs}
-        with raises(ValueError) as excinfo:
+        with raises(ValueError, naming=name):
             impl.farthest_point_sampling(**arguments)
-        assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"
 
 
 # --- normal_space_sampling ------------------------------------------------------------------
@@ -544,6 +541,5 @@ def test_normal_space_sampling_rejects_bad_input(impl, skewed_normals):
         ({"normals": np.zeros((5, 2))}, "normals"),
     ):
         arguments = {"normals": skewed_normals, "n_samples": 10, **kwargs}
-        with raises(ValueError) as excinfo:
+        with raises(ValueError, naming=name):
             impl.normal_space_sampling(**arguments)
-        assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"

@@ -68,9 +68,8 @@ def test_radius_outlier_removal_on_an_empty_cloud(impl):
 @pytest.mark.points(0.5)
 @pytest.mark.interface
 def test_radius_outlier_removal_rejects_a_bad_radius(impl):
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="radius"):
         impl.radius_outlier_removal(np.zeros((3, 3)), 0.0, 2)
-    assert "radius" in str(excinfo.value), f"the ValueError must name 'radius', got: {excinfo.value}"
 
 
 # --- statistical_outlier_removal ----------------------------------------------------
@@ -195,9 +194,8 @@ def test_statistical_outlier_removal_keeps_an_evenly_spaced_cloud(impl):
 def test_statistical_outlier_removal_rejects_bad_k(impl):
     points = np.random.default_rng(54).normal(size=(10, 3))
     for bad in (0, 10):
-        with raises(ValueError) as excinfo:
+        with raises(ValueError, naming="k"):
             impl.statistical_outlier_removal(points, bad, 1.0)
-        assert "k" in str(excinfo.value), f"the ValueError must name 'k', got: {excinfo.value}"
 
 
 # --- bilateral_filter_image ---------------------------------------------------------

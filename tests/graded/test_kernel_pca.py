@@ -87,12 +87,10 @@ def test_kernel_matrix_closed_forms(impl, kernel):
 @pytest.mark.interface
 def test_kernel_matrix_rejects_unknown_kernel_and_bad_beta(impl):
     x = np.zeros((2, 2))
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="kernel"):
         impl.kernel_matrix(x, x, kernel="sigmoid")
-    assert "kernel" in str(excinfo.value), f"the ValueError must name 'kernel', got: {excinfo.value}"
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="beta"):
         impl.kernel_matrix(x, x, kernel="gaussian", beta=0.0)
-    assert "beta" in str(excinfo.value), f"the ValueError must name 'beta', got: {excinfo.value}"
 
 
 # --- kernel_pca -------------------------------------------------------------
@@ -200,9 +198,8 @@ def test_kernel_pca_with_the_linear_kernel_is_linear_pca(impl):
 @pytest.mark.interface
 def test_kernel_pca_rejects_bad_n_components(impl, blob):
     for bad in (0, 61):
-        with raises(ValueError) as excinfo:
+        with raises(ValueError, naming="n_components"):
             impl.kernel_pca(blob, bad)
-        assert "n_components" in str(excinfo.value), f"the ValueError must name 'n_components': {excinfo.value}"
 
 
 # --- kernel_pca_transform ----------------------------------------------------

@@ -158,17 +158,14 @@ def test_knn_result_set_with_fewer_candidates_than_k_is_not_padded(impl):
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_knn_result_set_rejects_bad_input(impl):
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="distances"):
         impl.knn_result_set(np.array([1.0, -1.0]), np.array([0, 1]), 1)
-    assert "distances" in str(excinfo.value)
     with raises(ValueError):
         impl.knn_result_set(np.array([1.0, np.nan]), np.array([0, 1]), 1)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="indices"):
         impl.knn_result_set(np.array([1.0, 2.0]), np.array([0]), 1)
-    assert "indices" in str(excinfo.value)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="k"):
         impl.knn_result_set(np.array([1.0]), np.array([0]), 0)
-    assert "k" in str(excinfo.value)
 
 
 # -- bst_build, bst_knn ----------------------------------------------------------------------------
@@ -214,9 +211,8 @@ def test_bst_build_empty_and_bad_keys(impl):
     left, right = impl.bst_build(np.empty(0))
     check_array(left, "left", shape=(0,), dtype="int64")
     check_array(right, "right", shape=(0,), dtype="int64")
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="keys"):
         impl.bst_build(np.array([1.0, np.inf]))
-    assert "keys" in str(excinfo.value)
 
 
 def bst_of(impl, keys):
@@ -277,9 +273,8 @@ def test_bst_knn_on_a_path_of_sorted_keys(impl):
 def test_bst_knn_rejects_bad_input(impl):
     keys = np.array([5.0, 3.0, 8.0])
     left, right = np.array([1, -1, -1]), np.array([2, -1, -1])
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="k"):
         impl.bst_knn(keys, left, right, 4.0, 4)
-    assert "k" in str(excinfo.value)
     with raises(ValueError):
         impl.bst_knn(keys, np.array([1, 1, -1]), right, 4.0, 1)  # node 1 is its own child
     with raises(ValueError):
@@ -343,9 +338,8 @@ def test_kdtree_build_edge_cases_and_bad_input(impl):
     check_kdtree(empty, np.empty((0, 3)), 16)
     points = cube(10, 28)
     check_kdtree(impl.kdtree_build(points, 10), points, 10)  # one leaf
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="leaf_size"):
         impl.kdtree_build(points, 0)
-    assert "leaf_size" in str(excinfo.value)
     with raises(ValueError):
         impl.kdtree_build(np.array([[0.0, np.nan]]), 1)
 
@@ -394,15 +388,12 @@ def test_kdtree_knn_bad_input_and_no_queries(impl):
     tree = kd_tree(impl, points, 4)
     indices, distances = impl.kdtree_knn(tree, points, np.empty((0, 3)), 3)
     check_array(indices, "indices", shape=(0, 3), dtype="int64")
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="k"):
         impl.kdtree_knn(tree, points, points[:2], 51)
-    assert "k" in str(excinfo.value)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="queries"):
         impl.kdtree_knn(tree, points, np.zeros((2, 2)), 1)
-    assert "queries" in str(excinfo.value)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="tree"):
         impl.kdtree_knn({"order": tree["order"]}, points, points[:2], 1)
-    assert "tree" in str(excinfo.value)
 
 
 @pytest.mark.grades("kdtree_radius")
@@ -443,9 +434,8 @@ def test_kdtree_radius_rejects_bad_radii(impl):
     points = cube(30, 48)
     tree = kd_tree(impl, points, 4)
     for radius in (-0.1, np.nan, np.inf):
-        with raises(ValueError) as excinfo:
+        with raises(ValueError, naming="radius"):
             impl.kdtree_radius(tree, points, points[:2], radius)
-        assert "radius" in str(excinfo.value)
 
 
 # -- octree_build -------------------------------------------------------------------------------
@@ -509,12 +499,10 @@ def test_octree_build_edge_cases_and_bad_input(impl):
     tree = impl.octree_build(np.empty((0, 3)))
     check_octree(tree, np.empty((0, 3)), 8, 1e-3)
     check_octree(impl.octree_build(np.ones((1, 3))), np.ones((1, 3)), 8, 1e-3)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="min_extent"):
         impl.octree_build(cube(10, 56), 1, 0.0)
-    assert "min_extent" in str(excinfo.value)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="points"):
         impl.octree_build(cube(10, 56)[:, :2])
-    assert "points" in str(excinfo.value)
 
 
 # -- octree_radius, octree_knn -------------------------------------------------------------------
@@ -548,9 +536,8 @@ def test_octree_radius_on_a_grid(impl):
 def test_octree_radius_rejects_bad_input(impl):
     points = cube(30, 67)
     tree = oc_tree(impl, points, 4)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="radius"):
         impl.octree_radius(tree, points, points[:2], -1.0)
-    assert "radius" in str(excinfo.value)
     indptr, indices, distances = impl.octree_radius(tree, points, np.empty((0, 3)), 0.5)
     assert indptr.tolist() == [0] and len(indices) == 0, "no queries: indptr [0] and empty rows"
 
@@ -583,9 +570,7 @@ def test_octree_knn_on_a_grid_with_exact_ties(impl):
 def test_octree_knn_rejects_bad_input(impl):
     points = cube(30, 77)
     tree = oc_tree(impl, points, 4)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="k"):
         impl.octree_knn(tree, points, points[:2], 0)
-    assert "k" in str(excinfo.value)
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="tree"):
         impl.octree_knn(tree, points[:20], points[:2], 1)  # a tree of 30 points
-    assert "tree" in str(excinfo.value)

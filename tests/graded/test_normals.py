@@ -117,9 +117,8 @@ def test_fit_plane_does_not_modify_its_input(impl):
 def test_fit_plane_rejects_bad_weights(impl, weights):
     points = np.random.default_rng(3).standard_normal((6, 3))
     bad = {"negative": [1, 1, -1, 1, 1, 1], "zero-sum": np.zeros(6), "wrong-length": np.ones(5)}[weights]
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming="weights"):
         impl.fit_plane(points, bad)
-    assert "weights" in str(excinfo.value), f"the ValueError must name 'weights', got: {excinfo.value}"
 
 
 # --- estimate_normals ------------------------------------------------------
@@ -369,6 +368,5 @@ def test_estimate_normals_does_not_modify_its_input(impl):
 @pytest.mark.interface
 def test_estimate_normals_rejects_bad_input(impl, kwargs, name):
     arguments = {"points": np.random.default_rng(15).uniform(size=(10, 3)), "k": 5, **kwargs}
-    with raises(ValueError) as excinfo:
+    with raises(ValueError, naming=name):
         impl.estimate_normals(**arguments)
-    assert name in str(excinfo.value), f"the ValueError must name '{name}', got: {excinfo.value}"

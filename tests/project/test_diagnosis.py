@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from grading import GRADED_FUNCTIONS
+from grading.checks import UNNAMED_ARGUMENT
 from grading.config import EXERCISE_MODULES, FORBIDDEN_IN_MODULE
 from grading.diagnosis import (
     _IMPORT_FIXES,
@@ -40,7 +41,7 @@ from grading.diagnosis import (
     _extra_columns,
     _known_mistake,
     _modified_input,
-    _one_rule,
+    _names_another_argument,
     _result_type,
     _same_error_everywhere,
     _signature,
@@ -338,28 +339,21 @@ def test_did_not_raise_is_silent_when_another_test_failed_otherwise():
     assert run(_did_not_raise, calls, {**failed("t1", kind=DID_NOT_RAISE), **failed("t2", interface=True)}) is None
 
 
-def test_one_rule_names_the_rule_every_failed_test_breaks():
-    """Two failed checks of one rule: the rule is named, both tests explained."""
-    outcomes = {**failed("t1", "t2", kind=CHECK, rule="the eigenvectors are unit vectors"), **passed("t3")}
-    found = run(_one_rule, [], outcomes)
-    assert found == Diagnosis(
-        "one_rule", "every failed test breaks one rule: the eigenvectors are unit vectors", ("t1", "t2")
-    )
+def test_an_error_naming_another_argument_is_told_so_with_the_contracts_names():
+    rule = f"{UNNAMED_ARGUMENT}, 'queries'"
+    outcomes = {**failed("t1", "t2", kind=CHECK, rule=rule, interface=True), **passed("t3")}
+    found = run(_names_another_argument, [], outcomes)
+    assert found is not None and found.explains == ("t1", "t2")
+    assert found.message.endswith("must name the bad argument as the contract does: 'queries'")
+    other = {**outcomes, **failed("t4", kind=CHECK, rule="rows differ from brute force")}
+    assert run(_names_another_argument, [], other) is None  # another failure: not this
 
 
-@pytest.mark.parametrize(
-    "outcomes",
-    [
-        failed("t1", kind=CHECK, rule="r"),  # one failed test is no pattern
-        {**failed("t1", kind=CHECK, rule="r"), **failed("t2", kind=CHECK, rule="s")},
-        failed("t1", "t2", kind=CHECK),  # no rule recorded
-        failed("t1", "t2", kind=ASSERTION, rule="r"),  # not checks
-    ],
-    ids=["one test", "two rules", "no rule", "not checks"],
-)
-def test_one_rule_is_silent_without_one_shared_rule(outcomes):
-    """One failed test, two rules, no rule or failures of another kind: no finding."""
-    assert run(_one_rule, [], outcomes) is None
+def test_one_rule_shared_by_every_failed_test_is_no_diagnosis():
+    """The failed tests' own rule, repeated, names nothing the tests do not say (the README: where
+    nothing matches, there is no line); it was "every failed test breaks one rule: rows differ"."""
+    outcomes = {**failed("t1", "t2", kind=CHECK, rule="radius search: rows differ from brute force"), **passed("t3")}
+    assert diagnose(FUNCTION, [], outcomes) is None
 
 
 # -- 4. the catalogue: naming --------------------------------------------------------------------

@@ -124,3 +124,25 @@ def test_the_hand_worked_octree_names_the_field_that_differs(tmp_path):
     (test,) = summary["tests"]
     assert test["status"] == "failed" and "extent (half the side of each node's cube" in test["text"], test["text"]
     assert "Use -v" not in test["text"]
+
+
+def test_an_error_naming_the_wrong_argument_is_told_which_argument(tmp_path):
+    # "qs" for "queries" got "does not check its input" and pytest's "<grading.checks.raises object at 0x...>".
+    from _helpers import run_grader
+
+    module = tmp_path / "nn.py"
+    module.write_text(
+        "import numpy as np\n"
+        "from solutions.nn import *  # noqa: F401,F403\n"
+        "from solutions.nn import kdtree_knn as _search\n\n\n"
+        "def kdtree_knn(tree, points, queries, k):\n"
+        "    if np.shape(queries)[-1] != np.shape(points)[1]:\n"
+        "        raise ValueError('qs: one row per query, as wide as the points')\n"
+        "    return _search(tree, points, queries, k)\n"
+    )
+    arguments = ("--reference", "--impl-module", f"nn={module}", "-k", "test_kdtree_knn_bad_input")
+    summary, _ = run_grader(*arguments, tmp_path=tmp_path)
+    (test,) = summary["tests"]
+    assert test["status"] == "failed"
+    assert "the ValueError must name the bad argument, 'queries'; its message was: 'qs: one row" in test["text"]
+    assert "object at 0x" not in test["text"] and "does not check its input" not in test["text"], test["text"]
