@@ -25,6 +25,15 @@ def _knn_rows(best_sets, k):
     return indices, distances
 
 
+def _best(k, sentinel=None):
+    """The k best so far; with ``sentinel``, k slots of (sentinel, 0) to start with (the known mistake
+    of a finite starting worst distance: a farther candidate is never held, the slots are returned)."""
+    best = Best(k)
+    if sentinel is not None:
+        best.held = [(sentinel, 0)] * k
+    return best
+
+
 def _csr_rows(rows):
     indptr = np.zeros(len(rows) + 1, dtype=np.int64)
     indptr[1:] = np.cumsum([len(r) for r in rows])
@@ -45,13 +54,15 @@ def kdtree_search(
     far_first=False,
     prune=True,
     unsquared=False,
+    sentinel=None,
 ):
     """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
 
     The flags give known wrong versions: ``strict_prune`` (the far child only
     if ``d2 < w2``), ``strict_keep`` (radius: a point only if ``s < r2``),
     ``far_first``, ``prune=False`` (every leaf), ``unsquared`` (the far child
-    if ``|d| <= w2``: a distance against a squared one).
+    if ``|d| <= w2``: a distance against a squared one), ``sentinel`` (kNN:
+    the worst squared distance starts at this finite value, :func:`_best`).
     """
     points = np.asarray(points, dtype=float)
     queries = _as_rows(queries, points.shape[1])
@@ -63,7 +74,7 @@ def kdtree_search(
         return _csr_rows([list(zip((r[1] ** 2).tolist(), r[0].tolist())) for r in rows])
     results = []
     for query in queries:
-        best = Best(k) if k is not None else None
+        best = _best(k, sentinel) if k is not None else None
         found = []
 
         def visit(node, query=query, best=best, found=found):
@@ -105,6 +116,7 @@ def octree_search(
     box=False,
     strict=False,
     stop_at_miss=False,
+    sentinel=None,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -114,7 +126,8 @@ def octree_search(
     meets the ball if it meets the ball's bounding box: too weak),
     ``strict`` (a cube meets the ball only if its distance is below the
     radius: the course scaffold's ``overlaps``, which loses points on a face),
-    ``stop_at_miss`` (a leaf's scan ends at its first point outside the ball).
+    ``stop_at_miss`` (a leaf's scan ends at its first point outside the ball),
+    ``sentinel`` (kNN: a finite starting worst squared distance, :func:`_best`).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -127,7 +140,7 @@ def octree_search(
         return cell_gap_squared(query, c, e) < w2 if strict else cell_gap_squared(query, c, e) <= w2
 
     for query in queries:
-        best = Best(k) if k is not None else None
+        best = _best(k, sentinel) if k is not None else None
         found = []
 
         def offer(node, everything=False, query=query, best=best, found=found):
@@ -174,9 +187,10 @@ def octree_search(
     return _knn_rows(results, k) if k is not None else _csr_rows(results)
 
 
-def bst_search(keys, left, right, query, k, strict=False):
-    """The contract's BST search (``strict``: the far side only if ``|key - q| < w``, a known mistake)."""
-    best = Best(k)
+def bst_search(keys, left, right, query, k, strict=False, sentinel=None):
+    """The contract's BST search (``strict``: the far side only if ``|key - q| < w``, ``sentinel``: a
+    finite starting worst distance, :func:`_best`; known mistakes)."""
+    best = _best(k, sentinel)
     stack = [(0, False)]
     while stack:
         node, near_done = stack.pop()

@@ -52,6 +52,18 @@ def grid(side, dim=3):
     return np.stack(axes, axis=-1).reshape(-1, dim)
 
 
+def far_cloud(n, seed):
+    """UTM-like coordinates (millions of metres) whose values are at least 2 m apart along each axis,
+    and queries 1e11 m away along each axis: every neighbour of those lies beyond any finite
+    "worst distance" a student might start with, and rounding cannot tie two of them."""
+    rng = np.random.default_rng(seed)
+    points = np.column_stack([rng.permutation(3.0 * np.arange(n) + rng.uniform(0, 1, n)) for _ in range(3)])
+    points += [4.0e6, -2.0e6, 1.0e3]
+    centre = points.mean(axis=0)
+    queries = centre + 1.0e11 * np.vstack([np.eye(3), -np.eye(3)])
+    return points, np.vstack([queries, points[:4] + 0.5])
+
+
 def squared(points, query):
     total = np.zeros(len(points))
     for j in range(points.shape[1]):
@@ -232,15 +244,19 @@ def test_bst_knn_matches_brute_force(impl):
     rng = np.random.default_rng(12)
     keys = np.round(rng.normal(0, 10, 400), 1)  # ties among keys and distances
     left, right = bst_of(impl, keys)
-    for query, k in ((0.05, 1), (3.0, 7), (-40.0, 5), (12.35, 400), (rng.normal(0, 10), 25)):
+    far = ((-1.0e11, 40), (2.5e11, 3))  # every key beyond any finite starting worst distance
+    for query, k in ((0.05, 1), (3.0, 7), (-40.0, 5), (12.35, 400), (rng.normal(0, 10), 25), *far):
         indices, distances = impl.bst_knn(keys, left, right, query, k)
         expected = np.lexsort((np.arange(len(keys)), np.abs(keys - query)))[:k]
         check_array(indices, "indices", shape=(k,), dtype="int64")
-        assert indices.tolist() == expected.tolist(), (
-            f"query {query:g}, k={k}: got {indices[:6]}, expected {expected[:6]}: "
-            "the k nearest by |key - query|, ties by the lower index"
+        check_array(distances, "distances", shape=(k,))
+        check_knn(
+            indices[None],
+            distances[None],
+            expected[None],
+            np.abs(keys[expected] - query)[None],
+            f"bst_knn, query {query:g}, k={k}",
         )
-        assert np.allclose(distances, np.abs(keys[expected] - query), rtol=0, atol=1e-12)
 
 
 @pytest.mark.grades("bst_knn")
@@ -368,6 +384,9 @@ def test_kdtree_knn_self_far_and_large_coordinate_queries(impl):
     check_knn(*impl.kdtree_knn(tree, points, queries, 6), *brute_knn(points, queries, 6), "kdtree_knn")
     indices, distances = impl.kdtree_knn(tree, points, points[:5], 1)
     assert indices[:, 0].tolist() == list(range(5)) and np.all(distances == 0), "a point is its own nearest"
+    points, queries = far_cloud(300, 38)  # the k-th neighbour 1e11 away
+    tree = kd_tree(impl, points, 8)
+    check_knn(*impl.kdtree_knn(tree, points, queries, 20), *brute_knn(points, queries, 20), "kdtree_knn, far queries")
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -549,6 +568,7 @@ def test_octree_knn_matches_brute_force(impl):
         (cube(2000, 71), cube(50, 72) * 1.2, 8, 8),
         (scan_like(2000, 73), scan_like(50, 74), 5, 16),
         (cube(300, 75), cube(20, 76), 300, 4),  # k = N
+        (*far_cloud(300, 78), 20, 8),  # UTM-like coordinates, the k-th neighbour 1e11 away
     ):
         tree = oc_tree(impl, points, leaf)
         check_knn(*impl.octree_knn(tree, points, queries, k), *brute_knn(points, queries, k), "octree_knn")

@@ -13,11 +13,12 @@ import numpy as np
 __all__ = ["bst_knn", "kdtree_build", "kdtree_knn", "kdtree_radius", "octree_knn", "octree_radius"]
 
 
-def bst_knn(keys, left, right, query, k, prune="<=", far_when_left="right"):
+def bst_knn(keys, left, right, query, k, prune="<=", far_when_left="right", sentinel=None):
     """k nearest keys by a plain explicit-stack search; ``prune`` is "<=" or "<", and ``far_when_left``
-    is the child searched as the far side of a query left of a node ("left": the copy-and-paste slip)."""
+    is the child searched as the far side of a query left of a node ("left": the copy-and-paste slip).
+    ``sentinel``: the result set starts as k slots (sentinel, 0), the homework's finite "worst distance"."""
     keys = np.asarray(keys, dtype=float)
-    held = []  # (gap, index), sorted
+    held = _slots(k, sentinel)  # (gap, index), sorted
 
     def worst():
         return held[-1][0] if len(held) == k else np.inf
@@ -82,8 +83,13 @@ def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="d
     return tree
 
 
-def _kd_search(tree, points, query, k, radius, far_first, prune, keep):
-    held = []  # (squared distance, index), sorted
+def _slots(k, sentinel):
+    """A result set's starting slots: none, or k of (sentinel, 0) (a finite worst distance, the mistake)."""
+    return [] if sentinel is None else [(sentinel, 0)] * k
+
+
+def _kd_search(tree, points, query, k, radius, far_first, prune, keep, sentinel=None):
+    held = _slots(k, sentinel)  # (squared distance, index), sorted
 
     def bound():
         if k is None:
@@ -113,10 +119,13 @@ def _kd_search(tree, points, query, k, radius, far_first, prune, keep):
     return sorted(held)
 
 
-def kdtree_knn(tree, points, queries, k, far_first=False, prune="<="):
-    """kNN rows of a plain depth-first search; ``prune`` is "<=", "<", "none" or "|d| <= w2"."""
+def kdtree_knn(tree, points, queries, k, far_first=False, prune="<=", sentinel=None):
+    """kNN rows of a plain depth-first search; ``prune`` is "<=", "<", "none" or "|d| <= w2";
+    ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`)."""
     points = np.asarray(points, dtype=float)
-    rows = [_kd_search(tree, points, q, k, None, far_first, prune, "<=") for q in np.asarray(queries, dtype=float)]
+    rows = [
+        _kd_search(tree, points, q, k, None, far_first, prune, "<=", sentinel) for q in np.asarray(queries, dtype=float)
+    ]
     return _knn_arrays(rows, k)
 
 
@@ -127,8 +136,10 @@ def kdtree_radius(tree, points, queries, radius, prune="<=", keep="<="):
     return _csr_arrays(rows)
 
 
-def _octree_search(tree, xyz, query, k, radius, contains, early, own_first, box, strict, stop_at_miss=False):
-    held = []  # (squared distance, index), sorted
+def _octree_search(
+    tree, xyz, query, k, radius, contains, early, own_first, box, strict, stop_at_miss=False, sentinel=None
+):
+    held = _slots(k, sentinel) if k is not None else []  # (squared distance, index), sorted
 
     def bound():
         if k is None:
@@ -173,10 +184,11 @@ def _octree_search(tree, xyz, query, k, radius, contains, early, own_first, box,
     return sorted(held)
 
 
-def octree_knn(tree, points, queries, k, early=True, own_first=True, box=False, strict=False):
-    """kNN rows of a plain recursive octree search (Behley's order and early termination by default)."""
+def octree_knn(tree, points, queries, k, early=True, own_first=True, box=False, strict=False, sentinel=None):
+    """kNN rows of a plain recursive octree search (Behley's order and early termination by default);
+    ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (True, early, own_first, box, strict)
+    flags = (True, early, own_first, box, strict, False, sentinel)
     rows = [_octree_search(tree, xyz, q[:3], k, None, *flags) for q in np.asarray(queries, dtype=float)]
     return _knn_arrays(rows, k)
 

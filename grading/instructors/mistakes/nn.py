@@ -27,6 +27,22 @@ FILTERS_BY_CELL = (
 )
 
 
+FINITE_SENTINEL = (
+    "the worst distance is inf while fewer than k are held, not a large finite number: a query whose k-th "
+    "neighbour lies farther gets your padding (and a far side that far is pruned before k are held)"
+)
+# The finite starting worst distances students write (1e10 in the course's homework), on the
+# distance; the k-d tree and octree searches hold squared distances.
+SENTINELS = (1e5, 1e8, 1e9, 1e10)
+
+
+def _finite_sentinel(search, squared):
+    """The searches with each known finite sentinel: Variants, one per value."""
+    return lambda **arguments: Variants(
+        search(**arguments, sentinel=value**2 if squared else value) for value in SENTINELS
+    )
+
+
 def _cell_filtered(case, tree, points, queries, **argument):
     """The cell-filter cheat on one search's arguments: every leaf, or every leaf but the query's own, filtered."""
     tree, points, queries = case(tree, points, queries)
@@ -168,8 +184,8 @@ def _bst_case(keys, left, right, query, k):
     return keys, left, right, float(query), _k_of(k, len(keys))
 
 
-def bst_knn(keys, left, right, query, k, strict=False):
-    return tree_searches.bst_search(*_bst_case(keys, left, right, query, k), strict=strict)
+def bst_knn(keys, left, right, query, k, **changes):
+    return tree_searches.bst_search(*_bst_case(keys, left, right, query, k), **changes)
 
 
 def bst_brute(keys, left, right, query, k):
@@ -213,6 +229,7 @@ BST_KNN = Model(
             lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, strict=True),
         ),
         Mistake("filters_by_cell", FILTERS_BY_CELL, bst_interval_filtered),
+        Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(bst_knn, squared=False)),
     ),
 )
 
@@ -322,6 +339,7 @@ KDTREE_KNN = Model(
             FILTERS_BY_CELL,
             lambda tree, points, queries, k: _cell_filtered(_kd_case, tree, points, queries, k=k),
         ),
+        Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(kdtree_knn, squared=True)),
     ),
 )
 
@@ -519,6 +537,7 @@ OCTREE_KNN = Model(
             FILTERS_BY_CELL,
             lambda tree, points, queries, k: _cell_filtered(_octree_case, tree, points, queries, k=k),
         ),
+        Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(octree_knn, squared=True)),
     ),
 )
 

@@ -1,0 +1,14 @@
+"""The homework's result set: k slots of (1e10, 0) to start with, so that the worst distance is 1e10, not
+infinity, while fewer than k are held: a query whose k-th neighbour lies beyond 1e10 gets the padding, and
+a far side beyond 1e10 is pruned before k neighbours are held."""
+
+from solutions.nn import *  # noqa: F401,F403
+from solutions.nn import bst_knn as _reference
+from tests.mutants import _plain_trees
+
+MISTAKE = "finite_sentinel"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
+
+
+def bst_knn(keys, left, right, query, k):
+    _reference(keys, left, right, query, k)  # validation only
+    return _plain_trees.bst_knn(keys, left, right, query, k, sentinel=1e10)  # on the distance
