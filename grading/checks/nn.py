@@ -286,8 +286,13 @@ def check_csr(result, expected_rows, what="radius search"):
     for i, (rows, dists) in enumerate(expected_rows):
         got = indices[indptr[i] : indptr[i + 1]]
         if not np.array_equal(got, rows):
+            missing = np.setdiff1d(rows, got)
             if set(got.tolist()) == set(rows.tolist()):
                 hint = "the right neighbours in another order: sort each row by (squared distance, index)"
+            elif len(missing) and np.all(dists[np.isin(rows, missing)] == 0):
+                hint = (
+                    "the points at distance 0 (the query itself, its duplicates) are neighbours too: keep s <= r ** 2"
+                )
             elif len(got) < len(rows):
                 hint = "neighbours are missing: the test is inclusive (<= radius ** 2); prune only what cannot hold one"
             else:

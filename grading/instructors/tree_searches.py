@@ -55,6 +55,7 @@ def kdtree_search(
     prune=True,
     unsquared=False,
     sentinel=None,
+    drop_zero=False,
 ):
     """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -62,7 +63,8 @@ def kdtree_search(
     if ``d2 < w2``), ``strict_keep`` (radius: a point only if ``s < r2``),
     ``far_first``, ``prune=False`` (every leaf), ``unsquared`` (the far child
     if ``|d| <= w2``: a distance against a squared one), ``sentinel`` (kNN:
-    the worst squared distance starts at this finite value, :func:`_best`).
+    the worst squared distance starts at this finite value, :func:`_best`),
+    ``drop_zero`` (radius: a point only if ``0 < s``, the query's duplicates lost).
     """
     points = np.asarray(points, dtype=float)
     queries = _as_rows(queries, points.shape[1])
@@ -85,6 +87,7 @@ def kdtree_search(
                     best.offer_all(s, indices)
                 else:
                     keep = (s < radius**2) | ((s == radius**2) & (not strict_keep))
+                    keep &= (s > 0) | (not drop_zero)
                     found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
                 return
             diff = query[tree["axis"][node]] - tree["split"][node]
@@ -117,6 +120,7 @@ def octree_search(
     strict=False,
     stop_at_miss=False,
     sentinel=None,
+    drop_zero=False,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -127,7 +131,9 @@ def octree_search(
     ``strict`` (a cube meets the ball only if its distance is below the
     radius: the course scaffold's ``overlaps``, which loses points on a face),
     ``stop_at_miss`` (a leaf's scan ends at its first point outside the ball),
-    ``sentinel`` (kNN: a finite starting worst squared distance, :func:`_best`).
+    ``sentinel`` (kNN: a finite starting worst squared distance, :func:`_best`),
+    ``drop_zero`` (radius: a leaf's point only if ``0 < s``; a contained
+    octant's points are reported without a test, so kept).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -149,7 +155,7 @@ def octree_search(
             if best is not None:
                 best.offer_all(s, indices)
             else:
-                keep = np.ones(len(s), dtype=bool) if everything else s <= radius**2
+                keep = np.ones(len(s), dtype=bool) if everything else (s <= radius**2) & ((s > 0) | (not drop_zero))
                 if stop_at_miss and not keep.all():
                     keep[np.argmin(keep) :] = False
                 found.extend(zip(s[keep].tolist(), indices[keep].tolist()))

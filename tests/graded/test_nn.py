@@ -545,7 +545,7 @@ def test_octree_radius_on_a_grid(impl):
     for points in (grid(8), grid(9)):  # an odd side puts points on centre planes, on the lower octants' faces
         tree = oc_tree(impl, points, 2)
         queries = np.vstack([points[::11], points[::23] + 0.5])
-        for radius in (0.0, 1.0, 1.5, 3.0):  # points exactly at the radius, on centre planes and faces
+        for radius in (1.0, 1.5, 3.0, 0.0):  # points at exactly the radius, on centre planes and faces; duplicates
             check_csr(impl.octree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
 
 

@@ -103,7 +103,7 @@ def _kd_search(tree, points, query, k, radius, far_first, prune, keep, sentinel=
                 s = float(np.sum((points[index] - query) ** 2))
                 if k is not None:
                     held = sorted([*held, (s, int(index))])[:k]
-                elif s < radius**2 or (keep == "<=" and s == radius**2):
+                elif (s < radius**2 or (keep != "<" and s == radius**2)) and (keep != "0 < s <=" or s > 0):
                     held.append((s, int(index)))
             return
         diff = query[tree["axis"][node]] - tree["split"][node]
@@ -130,14 +130,27 @@ def kdtree_knn(tree, points, queries, k, far_first=False, prune="<=", sentinel=N
 
 
 def kdtree_radius(tree, points, queries, radius, prune="<=", keep="<="):
-    """CSR rows of a plain depth-first search; ``keep`` "<" drops the points at exactly the radius."""
+    """CSR rows of a plain depth-first search; ``keep`` "<" drops the points at exactly the radius,
+    "0 < s <=" the points at distance 0 (the query's duplicates)."""
     points = np.asarray(points, dtype=float)
     rows = [_kd_search(tree, points, q, None, radius, False, prune, keep) for q in np.asarray(queries, dtype=float)]
     return _csr_arrays(rows)
 
 
 def _octree_search(
-    tree, xyz, query, k, radius, contains, early, own_first, box, strict, stop_at_miss=False, sentinel=None
+    tree,
+    xyz,
+    query,
+    k,
+    radius,
+    contains,
+    early,
+    own_first,
+    box,
+    strict,
+    stop_at_miss=False,
+    sentinel=None,
+    drop_zero=False,
 ):
     held = _slots(k, sentinel) if k is not None else []  # (squared distance, index), sorted
 
@@ -152,7 +165,7 @@ def _octree_search(
             s = float(np.sum((xyz[index] - query) ** 2))
             if k is not None:
                 held = sorted([*held, (s, int(index))])[:k]
-            elif everything or s <= radius**2:
+            elif everything or (s <= radius**2 and (s > 0 or not drop_zero)):
                 held.append((s, int(index)))
             elif stop_at_miss:  # the leaf's later points are never tested
                 return
@@ -193,10 +206,13 @@ def octree_knn(tree, points, queries, k, early=True, own_first=True, box=False, 
     return _knn_arrays(rows, k)
 
 
-def octree_radius(tree, points, queries, radius, contains=True, box=False, strict=False, stop_at_miss=False):
-    """CSR rows of a plain recursive octree search (with the contains shortcut by default)."""
+def octree_radius(
+    tree, points, queries, radius, contains=True, box=False, strict=False, stop_at_miss=False, drop_zero=False
+):
+    """CSR rows of a plain recursive octree search (with the contains shortcut by default); ``drop_zero``:
+    a leaf's points at distance 0 are dropped (a contained octant's are reported untested)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (contains, False, True, box, strict, stop_at_miss)
+    flags = (contains, False, True, box, strict, stop_at_miss, None, drop_zero)
     rows = [_octree_search(tree, xyz, q[:3], None, radius, *flags) for q in np.asarray(queries, dtype=float)]
     return _csr_arrays(rows)
 

@@ -146,3 +146,12 @@ def test_an_error_naming_the_wrong_argument_is_told_which_argument(tmp_path):
     assert test["status"] == "failed"
     assert "the ValueError must name the bad argument, 'queries'; its message was: 'qs: one row" in test["text"]
     assert "object at 0x" not in test["text"] and "does not check its input" not in test["text"], test["text"]
+
+
+def test_a_radius_row_missing_only_its_distance_0_points_says_so():
+    # The hint was "the test is inclusive", which is not why the query's own duplicates were dropped.
+    rows = [(np.array([4, 7, 2]), np.array([0.0, 0.0, 0.5]))]
+    result = (np.array([0, 1]), np.array([2]), np.array([0.5]))
+    text = failure(check_csr, result, rows)
+    assert "the points at distance 0 (the query itself, its duplicates) are neighbours" in text
+    assert "inclusive" not in text

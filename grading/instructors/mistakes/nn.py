@@ -27,6 +27,11 @@ FILTERS_BY_CELL = (
 )
 
 
+DROPS_ZERO = (
+    "keep every point with squared distance <= r ** 2, 0 included: the query itself and its duplicates "
+    "are neighbours (a test 0 < s, or skipping the query's own index, drops them)"
+)
+
 FINITE_SENTINEL = (
     "the worst distance is inf while fewer than k are held, not a large finite number: a query whose k-th "
     "neighbour lies farther gets your padding (and a far side that far is pruned before k are held)"
@@ -368,6 +373,11 @@ KDTREE_RADIUS = Model(
             FILTERS_BY_CELL,
             lambda tree, points, queries, radius: _cell_filtered(_kd_case, tree, points, queries, radius=radius),
         ),
+        Mistake(
+            "drops_zero",
+            DROPS_ZERO,
+            lambda tree, points, queries, radius: kdtree_radius(tree, points, queries, radius, drop_zero=True),
+        ),
     ),
 )
 
@@ -502,6 +512,14 @@ OCTREE_RADIUS = Model(
             "filters_by_cell",
             FILTERS_BY_CELL,
             lambda tree, points, queries, radius: _cell_filtered(_octree_case, tree, points, queries, radius=radius),
+        ),
+        Mistake(
+            "drops_zero",
+            DROPS_ZERO,
+            lambda tree, points, queries, radius: Variants(
+                octree_radius(tree, points, queries, radius, drop_zero=True, contains=contains)
+                for contains in (True, False)
+            ),
         ),
     ),
 )
