@@ -125,6 +125,14 @@ def check_kdtree(tree, points, leaf_size):
         axis = int(tree["axis"][node])
         if axis != depth % dim:
             _fail(f"node {node} splits on axis {axis}, depth {depth} gives axis {depth % dim} (depth % D)", "axis rule")
+        if tree["left"][node] != node + 1:
+            if tree["right"][node] == node + 1:
+                _fail(
+                    f"node {node}: its right child is node {node + 1}, built before the left: preorder numbers a "
+                    "node, then its whole left subtree, then its right subtree (in ids and in order)",
+                    "nodes not in preorder",
+                )
+            _fail(f"node {node}: its left child must be node {node + 1} (preorder)", "nodes not in preorder")
         m = (size + 1) // 2
         indices = order[lo:hi]
         ranked = indices[np.lexsort((indices, points[indices, axis]))]
@@ -140,8 +148,6 @@ def check_kdtree(tree, points, leaf_size):
                 f"node {node}: split = {tree['split'][node]!r}, the rule gives (c[m-1] + c[m]) / 2 = {split!r}",
                 "the split value",
             )
-        if tree["left"][node] != node + 1:
-            _fail(f"node {node}: its left child must be node {node + 1} (preorder)", "nodes not in preorder")
         visit(int(tree["left"][node]), lo, lo + m, depth + 1)
         visit(int(tree["right"][node]), lo + m, hi, depth + 1)
 

@@ -130,7 +130,15 @@ def bst(keys, drop_equal=False):
 
 
 def kdtree(
-    points, leaf_size, median="ceil", split="mean", axis_rule="depth", partition="rank", ties="index", guard=True
+    points,
+    leaf_size,
+    median="ceil",
+    split="mean",
+    axis_rule="depth",
+    partition="rank",
+    ties="index",
+    guard=True,
+    first="left",
 ):
     """The contract's k-d tree (median rule, round-robin axes, preorder) as its dict.
 
@@ -139,8 +147,9 @@ def kdtree(
     ``axis_rule="spread"`` (the axis of largest spread), ``partition="value"``
     (points below the split left, a leaf where a side would be empty),
     ``ties="argsort"`` (equal coordinates in whatever order NumPy's default
-    argsort leaves them, as the course's scaffold sorts, not by index).
-    With ``guard=False`` a split that leaves a side empty makes an empty
+    argsort leaves them, as the course's scaffold sorts, not by index),
+    ``first="right"`` (the right subtree built, so numbered and laid out in
+    ``order``, before the left). With ``guard=False`` a split that leaves a side empty makes an empty
     child and recurses on the other with the same points at the next depth;
     when that comes back to the same axis, the recursion never ends:
     ``RecursionError``.
@@ -175,8 +184,12 @@ def kdtree(
             raise RecursionError("a child holds all of its parent's points on every axis: the recursion never ends")
         else:
             nodes[node][2:4] = [axis, at]
-            nodes[node][4] = grow(lower, depth + 1, unsplit)
-            nodes[node][5] = grow(upper, depth + 1, unsplit)
+            if first == "right":
+                nodes[node][5] = grow(upper, depth + 1, unsplit)
+                nodes[node][4] = grow(lower, depth + 1, unsplit)
+            else:
+                nodes[node][4] = grow(lower, depth + 1, unsplit)
+                nodes[node][5] = grow(upper, depth + 1, unsplit)
         nodes[node][1] = len(order)
         return node
 

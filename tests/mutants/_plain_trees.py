@@ -43,7 +43,9 @@ def bst_knn(keys, left, right, query, k, prune="<=", far_when_left="right", sent
     return np.array([i for _, i in held], dtype=np.int64), np.array([g for g, _ in held])
 
 
-def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="depth", partition="rank", ties="index"):
+def kdtree_build(
+    points, leaf_size=16, median="ceil", split="mean", axis_rule="depth", partition="rank", ties="index", first="left"
+):
     """A k-d tree in the contract's layout; the keywords other than the defaults are mistakes."""
     points = np.asarray(points, dtype=float)
     nodes, order = [], []
@@ -68,8 +70,8 @@ def kdtree_build(points, leaf_size=16, median="ceil", split="mean", axis_rule="d
             upper = [i for i in ranked if points[i, axis] >= at]
         if lower and upper or partition == "value, unguarded":
             nodes[node][2:4] = [axis, at]
-            nodes[node][4] = grow(lower, depth + 1)
-            nodes[node][5] = grow(upper, depth + 1)
+            for side, part in ((5, upper), (4, lower)) if first == "right" else ((4, lower), (5, upper)):
+                nodes[node][side] = grow(part, depth + 1)
         else:  # a split that leaves a side empty: a leaf, the guard a student adds after an endless recursion
             order.extend(sorted(indices))
         nodes[node][1] = len(order)

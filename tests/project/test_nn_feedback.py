@@ -155,3 +155,13 @@ def test_a_radius_row_missing_only_its_distance_0_points_says_so():
     text = failure(check_csr, result, rows)
     assert "the points at distance 0 (the query itself, its duplicates) are neighbours" in text
     assert "inclusive" not in text
+
+
+def test_a_kd_build_numbering_the_right_subtree_first_is_told_so():
+    # It was told "its left child must hold the 500 smallest points", which is true of that tree.
+    from grading.checks.nn import check_kdtree
+    from grading.instructors import trees
+
+    points = np.random.default_rng(3).normal(size=(1000, 3))
+    text = failure(check_kdtree, trees.kdtree(points, 16, first="right"), points, 16)
+    assert text.startswith("node 0: its right child is node 1, built before the left"), text

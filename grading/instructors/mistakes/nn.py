@@ -286,6 +286,12 @@ KDTREE_BUILD = Model(
             lambda points, leaf_size=16: kdtree_build(points, leaf_size, ties="argsort"),
         ),
         Mistake(
+            "right_subtree_first",
+            "build the left child before the right: preorder numbers a node, then its whole left subtree, then "
+            "its right subtree, in the node ids and in order",
+            lambda points, leaf_size=16: kdtree_build(points, leaf_size, first="right"),
+        ),
+        Mistake(
             "value_split",
             "the left child takes the first m = ceil(n / 2) points of the order by (coordinate, index), not the "
             "points below the split: equal coordinates fall on both sides of it, or duplicates would never split",
