@@ -121,6 +121,7 @@ def octree_search(
     stop_at_miss=False,
     sentinel=None,
     drop_zero=False,
+    unclamped=False,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -133,7 +134,9 @@ def octree_search(
     ``stop_at_miss`` (a leaf's scan ends at its first point outside the ball),
     ``sentinel`` (kNN: a finite starting worst squared distance, :func:`_best`),
     ``drop_zero`` (radius: a leaf's point only if ``0 < s``; a contained
-    octant's points are reported without a test, so kept).
+    octant's points are reported without a test, so kept), ``unclamped`` (a
+    cube's distance as sum_j (|q_j - c_j| - e) ** 2, each axis's gap not
+    clamped at 0: an axis where the query lies within the cube adds to it).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -143,6 +146,8 @@ def octree_search(
         c, e = tree["center"][node], tree["extent"][node]
         if box:
             return bool(np.all(np.abs(query - c) <= e + math.sqrt(w2)))
+        if unclamped:
+            return float(np.sum((np.abs(query - c) - e) ** 2)) <= w2
         return cell_gap_squared(query, c, e) < w2 if strict else cell_gap_squared(query, c, e) <= w2
 
     for query in queries:

@@ -153,6 +153,7 @@ def _octree_search(
     stop_at_miss=False,
     sentinel=None,
     drop_zero=False,
+    unclamped=False,
 ):
     held = _slots(k, sentinel) if k is not None else []  # (squared distance, index), sorted
 
@@ -176,7 +177,7 @@ def _octree_search(
         gap = np.abs(query - tree["center"][node]) - tree["extent"][node]
         if box:
             return bool(np.all(gap <= np.sqrt(bound())))
-        distance2 = float(np.sum(np.maximum(gap, 0.0) ** 2))
+        distance2 = float(np.sum(gap**2 if unclamped else np.maximum(gap, 0.0) ** 2))
         return distance2 < bound() if strict else distance2 <= bound()
 
     def visit(node):
@@ -199,22 +200,33 @@ def _octree_search(
     return sorted(held)
 
 
-def octree_knn(tree, points, queries, k, early=True, own_first=True, box=False, strict=False, sentinel=None):
+def octree_knn(
+    tree, points, queries, k, early=True, own_first=True, box=False, strict=False, sentinel=None, unclamped=False
+):
     """kNN rows of a plain recursive octree search (Behley's order and early termination by default);
     ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (True, early, own_first, box, strict, False, sentinel)
+    flags = (True, early, own_first, box, strict, False, sentinel, False, unclamped)
     rows = [_octree_search(tree, xyz, q[:3], k, None, *flags) for q in np.asarray(queries, dtype=float)]
     return _knn_arrays(rows, k)
 
 
 def octree_radius(
-    tree, points, queries, radius, contains=True, box=False, strict=False, stop_at_miss=False, drop_zero=False
+    tree,
+    points,
+    queries,
+    radius,
+    contains=True,
+    box=False,
+    strict=False,
+    stop_at_miss=False,
+    drop_zero=False,
+    unclamped=False,
 ):
     """CSR rows of a plain recursive octree search (with the contains shortcut by default); ``drop_zero``:
     a leaf's points at distance 0 are dropped (a contained octant's are reported untested)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (contains, False, True, box, strict, stop_at_miss, None, drop_zero)
+    flags = (contains, False, True, box, strict, stop_at_miss, None, drop_zero, unclamped)
     rows = [_octree_search(tree, xyz, q[:3], None, radius, *flags) for q in np.asarray(queries, dtype=float)]
     return _csr_arrays(rows)
 

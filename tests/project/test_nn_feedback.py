@@ -165,3 +165,14 @@ def test_a_kd_build_numbering_the_right_subtree_first_is_told_so():
     points = np.random.default_rng(3).normal(size=(1000, 3))
     text = failure(check_kdtree, trees.kdtree(points, 16, first="right"), points, 16)
     assert text.startswith("node 0: its right child is node 1, built before the left"), text
+
+
+def test_the_box_overlap_and_unclamped_gap_entries_describe_opposite_mistakes():
+    # The catalogue's box_overlap described an overlap test too weak; a gap not clamped at 0 is too strong
+    # and had no entry of its own ("rows differ").
+    from grading.instructors.mistakes import nn
+
+    for model in (nn.OCTREE_RADIUS, nn.OCTREE_KNN):
+        messages = {mistake.id: mistake.message for mistake in model.mistakes}
+        assert "clamp each axis's gap at 0" in messages["unclamped_gap"]
+    assert "too weak" in {m.id: m.message for m in nn.OCTREE_RADIUS.mistakes}["box_overlap"]

@@ -32,6 +32,11 @@ DROPS_ZERO = (
     "are neighbours (a test 0 < s, or skipping the query's own index, drops them)"
 )
 
+UNCLAMPED_GAP = (
+    "a cube's squared distance to the query is sum_j max(|q_j - c_j| - e, 0) ** 2: clamp each axis's gap at 0, "
+    "or an axis on which the query lies within the cube adds to it, and octants that hold neighbours are skipped"
+)
+
 FINITE_SENTINEL = (
     "the worst distance is inf while fewer than k are held, not a large finite number: a query whose k-th "
     "neighbour lies farther gets your padding (and a far side that far is pruned before k are held)"
@@ -520,6 +525,11 @@ OCTREE_RADIUS = Model(
             lambda tree, points, queries, radius: _cell_filtered(_octree_case, tree, points, queries, radius=radius),
         ),
         Mistake(
+            "unclamped_gap",
+            UNCLAMPED_GAP,
+            lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, unclamped=True),
+        ),
+        Mistake(
             "drops_zero",
             DROPS_ZERO,
             lambda tree, points, queries, radius: Variants(
@@ -560,6 +570,11 @@ OCTREE_KNN = Model(
             "filters_by_cell",
             FILTERS_BY_CELL,
             lambda tree, points, queries, k: _cell_filtered(_octree_case, tree, points, queries, k=k),
+        ),
+        Mistake(
+            "unclamped_gap",
+            UNCLAMPED_GAP,
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, unclamped=True),
         ),
         Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(octree_knn, squared=True)),
     ),
