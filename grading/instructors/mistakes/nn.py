@@ -27,6 +27,23 @@ FILTERS_BY_CELL = (
 )
 
 
+KEEPS_SWAPS = (
+    "your search checks whether points lie in their node's cell, and keeps those listed elsewhere only when "
+    "they are swapped both ways: the contract says to trust the tree; read only what the rule reaches, and "
+    "keep every point you read"
+)
+
+
+def _mutual_filtered(case, tree, points, queries, **argument):
+    """The cell-filter cheat that keeps the points swapped both ways (issue 35's hostile review, hole 5)."""
+    tree, points, queries = case(tree, points, queries)
+    if "k" in argument:
+        argument = {"k": _k_of(argument["k"], len(points))}
+    else:
+        argument = {"radius": _radius_of(argument["radius"])}
+    return tree_searches.cell_filtered_search(tree, points, queries, mutual=True, **argument)
+
+
 def _cell_filtered(case, tree, points, queries, **argument):
     """The cell-filter cheat on one search's arguments: every leaf, or every leaf but the query's own, filtered."""
     tree, points, queries = case(tree, points, queries)
@@ -322,6 +339,11 @@ KDTREE_KNN = Model(
             FILTERS_BY_CELL,
             lambda tree, points, queries, k: _cell_filtered(_kd_case, tree, points, queries, k=k),
         ),
+        Mistake(
+            "keeps_swaps",
+            KEEPS_SWAPS,
+            lambda tree, points, queries, k: _mutual_filtered(_kd_case, tree, points, queries, k=k),
+        ),
     ),
 )
 
@@ -349,6 +371,11 @@ KDTREE_RADIUS = Model(
             "filters_by_cell",
             FILTERS_BY_CELL,
             lambda tree, points, queries, radius: _cell_filtered(_kd_case, tree, points, queries, radius=radius),
+        ),
+        Mistake(
+            "keeps_swaps",
+            KEEPS_SWAPS,
+            lambda tree, points, queries, radius: _mutual_filtered(_kd_case, tree, points, queries, radius=radius),
         ),
     ),
 )
@@ -485,6 +512,11 @@ OCTREE_RADIUS = Model(
             FILTERS_BY_CELL,
             lambda tree, points, queries, radius: _cell_filtered(_octree_case, tree, points, queries, radius=radius),
         ),
+        Mistake(
+            "keeps_swaps",
+            KEEPS_SWAPS,
+            lambda tree, points, queries, radius: _mutual_filtered(_octree_case, tree, points, queries, radius=radius),
+        ),
     ),
 )
 
@@ -518,6 +550,11 @@ OCTREE_KNN = Model(
             "filters_by_cell",
             FILTERS_BY_CELL,
             lambda tree, points, queries, k: _cell_filtered(_octree_case, tree, points, queries, k=k),
+        ),
+        Mistake(
+            "keeps_swaps",
+            KEEPS_SWAPS,
+            lambda tree, points, queries, k: _mutual_filtered(_octree_case, tree, points, queries, k=k),
         ),
     ),
 )
