@@ -1,7 +1,9 @@
 """The lying trees of lecture 2's structure tests: decoys and traps.
 
 Decoys are points moved near the query into leaves no lawful search reads;
-traps are points swapped between leaves every lawful search must read. Why
+traps are points swapped between leaves every lawful search must read;
+counter-decoys give some decoys a partner, so that a decoy's misplacement
+is as mutual as a trap's. Why
 every correct search passes them, and every search that reads what its rule
 skips or drops what it reads fails, is proved in
 :mod:`grading.instructors.trees`'s docstring; the trees, their builds and
@@ -14,7 +16,7 @@ import numpy as np
 
 from grading.instructors.trees import DECOY_FRACTION, is_octree_leaf, squared_distances
 
-__all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps"]
+__all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps", "counter_decoys"]
 
 
 # -- lying trees ----------------------------------------------------------------------------------
@@ -170,14 +172,16 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
     read as a filter). The points themselves do not move.
 
     Radius search: A and B are any two leaves within ``radius`` of the query
-    (cell distance), neither the query's own leaf nor, in an octree, under a
-    node that the ball contains; p is a point of A within the radius, u any
-    point of B. kNN: A and B lie within the k-th distance, A comes before B
+    (cell distance), not, in an octree, under a node that the ball contains;
+    p is a point of A within the radius, u any point of B. kNN: A and B lie
+    within the k-th distance, A comes before B
     in the rule's depth-first order and is strictly nearer (cell distance),
     p is an answer point of B and u a point of A beyond the k-th distance
     (the module docstring proves why every lawful search still answers
     right). Each pair uses leaves of its own; the first pair is searched
-    among leaves other than the query's own one.
+    among leaves other than the query's own one, the others among all (so
+    that traps, as the counter-decoys' pairs do, pass through the query's
+    own leaf too).
 
     Parameters
     ----------
@@ -234,7 +238,7 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
     for attempt in range(2 * pairs):
         if len(swapped) == 2 * pairs:
             break
-        avoid_own = attempt == 0 or radius is not None
+        avoid_own = attempt == 0
         found = _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, used | (own if avoid_own else set()))
         if found is None:
             continue
@@ -345,3 +349,116 @@ def bst_trap_swaps(keys, left, right, query, k, pairs=2):
             swapped += [a, b]
             break
     return lying, np.array(swapped, dtype=np.int64)
+
+
+# -- counter-decoys: a partner for a decoy, so that a decoy's misplacement is mutual too ----------
+
+
+def _depth_inside(point, lower, upper):
+    """How far ``point`` lies inside the box (negative: outside), over every face."""
+    return float(np.min(np.minimum(point - lower, upper - point)))
+
+
+def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radius=None, swapped=(), pairs=2):
+    """``moved`` with a partner for some decoys: a point of the query's leaf moved into the decoy's leaf.
+
+    A decoy d is listed under a leaf U that the rule never reaches and lies
+    next to the query, in the query's own leaf Y (read by every search). A
+    counter-decoy c is a point listed under Y, moved into U's cell (to d's
+    vacated place, or halfway from it to another point of U): now d and c are
+    listed each under the other's leaf, a swap as mutual as a trap's, so a
+    search that keeps the out-of-cell points that are swapped both ways keeps
+    d and returns it. c is never in the answer and never changes what a
+    lawful search reads (the module docstring): its true and its new place
+    are both beyond the k-th distance or the radius, and for kNN the new one
+    is the nearer (c ranks before its true self, as a trap's p does).
+
+    Parameters
+    ----------
+    tree : dict
+        The true tree of ``points``.
+    lying_tree : dict
+        ``tree`` with the traps (:func:`trap_swaps`): c is listed under Y there.
+    points : ndarray, shape (N, D)
+        The true cloud.
+    moved : ndarray, shape (N, D)
+        The lying cloud of :func:`decoy_points`.
+    decoys : ndarray of int
+        The decoys of :func:`decoy_points`.
+    query : ndarray, shape (D,)
+    k, radius
+        Exactly one (as :func:`trap_swaps`).
+    swapped : array of int
+        The traps' points (never a counter-decoy).
+    pairs : int, default 2
+        At most this many counter-decoys.
+
+    Returns
+    -------
+    moved : ndarray, shape (N, D)
+        A copy of ``moved`` with the counter-decoys moved.
+    partnered : ndarray of int64
+        The decoys given a partner.
+    counters : ndarray of int64
+        Their partners, in the same order.
+    """
+    points = np.asarray(points, dtype=float)
+    octree = "axis" not in tree
+    width = 3 if octree else points.shape[1]
+    xyz = points[:, :width]
+    result = np.array(moved, dtype=float, copy=True)
+    query = np.asarray(query, dtype=float)[:width]
+    s = squared_distances(xyz, query)
+    bound2 = float(np.sort(s)[k - 1]) if k is not None else radius**2
+    if bound2 <= 0:
+        return result, np.empty(0, np.int64), np.empty(0, np.int64)
+    clearance = SWAP_CLEARANCE * math.sqrt(bound2)
+    walk = leaf_walk(tree, query)
+    boxes = {leaf: (lower, upper, path) for leaf, lower, upper, path in walk}
+    own = [leaf for leaf, lower, upper, _ in walk if _depth_inside(query, lower, upper) > clearance]
+    if len(own) != 1:
+        return result, np.empty(0, np.int64), np.empty(0, np.int64)
+    y = own[0]
+    y_lower, y_upper, y_path = boxes[y]
+    if radius is not None and octree and _contained_on_path(tree, y_path, query, radius):
+        return result, np.empty(0, np.int64), np.empty(0, np.int64)
+    listed = np.empty(len(points), dtype=np.int64)
+    for leaf in boxes:
+        listed[tree["order"][tree["start"][leaf] : tree["stop"][leaf]]] = leaf
+    excluded = set(np.asarray(swapped, dtype=np.int64).tolist()) | set(np.asarray(decoys).tolist())
+    candidates = [
+        int(i)
+        for i in lying_tree["order"][lying_tree["start"][y] : lying_tree["stop"][y]]
+        if int(i) not in excluded
+        and _depth_inside(xyz[i], y_lower, y_upper) > clearance
+        and s[i] > bound2 * (1 + TRAP_MARGIN)
+    ]
+    candidates.sort(key=lambda i: (-s[i], i))  # the farthest first: room for a place in U nearer than it
+    gaps = {leaf: _box_gap_squared(lower, upper, query) for leaf, (lower, upper, _) in boxes.items()}
+    partnered, counters = [], []
+    for d in sorted((int(d) for d in decoys), key=lambda d: (gaps[listed[d]], d)):  # the nearest leaves first
+        if len(counters) == pairs or not candidates:
+            break
+        if _depth_inside(result[d, :width], y_lower, y_upper) <= clearance * DECOY_FRACTION:
+            continue  # the decoy does not lie clearly in Y
+        u = listed[d]
+        u_lower, u_upper, _ = boxes[u]
+        members = tree["order"][tree["start"][u] : tree["stop"][u]]
+        places = [xyz[d]] + [(xyz[d] + xyz[v]) / 2 for v in members if v != d]
+        places = [
+            x
+            for x in places
+            if _depth_inside(x, u_lower, u_upper) > clearance
+            and float(squared_distances(x[None], query)[0]) > bound2 * (1 + TRAP_MARGIN)
+        ]
+        for x in sorted(places, key=lambda x: float(squared_distances(x[None], query)[0])):
+            sx = float(squared_distances(x[None], query)[0])
+            fits = [c for c in candidates if k is None or s[c] > sx * (1 + TRAP_MARGIN)]
+            if fits:
+                c = fits[0]
+                candidates.remove(c)
+                result[c, :width] = x
+                partnered.append(d)
+                counters.append(c)
+                break
+    return result, np.array(partnered, dtype=np.int64), np.array(counters, dtype=np.int64)

@@ -220,14 +220,19 @@ def bst_search(keys, left, right, query, k, strict=False, sentinel=None):
     return np.array([i for _, i in best.held], dtype=np.int64), np.array([s for s, _ in best.held], dtype=float)
 
 
-def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=False):
+def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=False, mutual=False):
     """A known cheat: every leaf read, its points outside the leaf's (closed) cell dropped, brute force on the rest.
 
     A point within a relative 1e-9 of its cell counts as inside (a cube
     ``c +- e`` in floating point can miss the cloud's extreme points by an
     ulp). ``own_leaf=True`` spares the query's own leaf (:func:`_own_leaf`).
-    On a true tree it answers right; on the structure tests' lying trees it
-    drops the decoys and the trapped points.
+    ``mutual=True`` keeps, of the points outside their leaf's cell, those
+    whose misplacement is mutual (some point listed under the leaf it lies in
+    lies in its own leaf), as the traps are: the hole of issue 35's hostile
+    review. On a true tree it answers right; on the structure tests' lying
+    trees it drops the decoys and the trapped points, or (``mutual``) keeps
+    the trapped points and the decoys that have a partner
+    (:func:`lying_trees.counter_decoys`).
     """
     points = np.asarray(points, dtype=float)
     width = points.shape[1] if "axis" in tree else 3
@@ -236,15 +241,18 @@ def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=Fa
     for query in np.asarray(queries, dtype=float).reshape(-1, np.asarray(queries).shape[-1])[:, :width]:
         walk = lying_trees.leaf_walk(tree, query)
         own = _own_leaf(tree, query) if own_leaf else None
-        kept = []
+        kept, strays = [], []  # strays: (index, listed under, lies in)
         for leaf, lower, upper, _ in walk:
             indices = tree["order"][tree["start"][leaf] : tree["stop"][leaf]]
             spared = leaf == own
-            slack = 1e-9 * (
-                1 + np.abs(np.nan_to_num(lower, posinf=0, neginf=0)) + np.abs(np.nan_to_num(upper, posinf=0, neginf=0))
-            )
-            inside = np.all((points[indices] >= lower - slack) & (points[indices] <= upper + slack), axis=1)
+            inside = _in_cell(points[indices], lower, upper)
             kept.extend(indices.tolist() if spared else indices[inside].tolist())
+            if mutual:
+                strays += [(int(i), leaf) for i in indices[~inside]]
+        if mutual:
+            lies_in = {index: _leaf_holding(walk, points[index]) for index, _ in strays}
+            edges = {(listed, lies_in[index]) for index, listed in strays}
+            kept += [index for index, listed in strays if (lies_in[index], listed) in edges]
         kept = np.array(sorted(kept), dtype=np.int64)
         s = squared_distances(points[kept], query)
         if k is not None:
@@ -254,6 +262,19 @@ def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=Fa
             inside = s <= radius**2
             rows.append(list(zip(s[inside].tolist(), kept[inside].tolist())))
     return _knn_rows(rows, k) if k is not None else _csr_rows(rows)
+
+
+def _leaf_holding(walk, point):
+    """The leaf of ``walk`` whose closed cell holds ``point`` (the first), or -1."""
+    return next((leaf for leaf, lower, upper, _ in walk if _in_cell(point[None], lower, upper)[0]), -1)
+
+
+def _in_cell(points, lower, upper):
+    """Which points lie in the closed cell, within a relative 1e-9."""
+    slack = 1e-9 * (
+        1 + np.abs(np.nan_to_num(lower, posinf=0, neginf=0)) + np.abs(np.nan_to_num(upper, posinf=0, neginf=0))
+    )
+    return np.all((points >= lower - slack) & (points <= upper + slack), axis=1)
 
 
 def _own_leaf(tree, query):

@@ -50,6 +50,40 @@ answers right:
   node: only the keys of childless nodes are swapped (a key elsewhere routes
   the search), B's key nearer than A's.
 
+**Counter-decoys** (:func:`counter_decoys`): the traps are swaps (each point
+listed under the other's leaf) while a decoy was one-way (listed under an
+unreached leaf U, lying by the query in its own leaf Y), so a search that
+keeps the misplaced points swapped both ways and drops the rest kept every
+trap and dropped every decoy (issue 35's hostile review, hole 5). So some
+decoys get a partner: a point c listed under Y, moved into U's cell (to the
+decoy's vacated place, or halfway from it to another point of U, well inside
+U's cell). Now d and c are listed each under the other's leaf, as a trap's
+two points are, and that search keeps d, which lies next to the query, and
+returns it. c's true and new places both lie beyond the k-th distance (or the
+radius), with margin; for kNN its new place is strictly nearer the query than
+its true one. Every lawful search still answers right:
+
+- Radius: the set read does not depend on the points, c is outside the ball
+  at both places, and Y lies under no node the ball contains (c, inside Y's
+  cell and outside the ball, shows it), so c is tested, and dropped.
+- kNN: on a given sequence of reads, the lying search offers c with a
+  smaller (s, index) than the true one, at the same time (when it reads Y),
+  and the trap's p earlier; all other points as on the true tree. So the
+  argument of the traps holds as it stands: the k-th held never exceeds the
+  true one's, the lying search reads a subset of what the true one reads
+  (never a decoy), and it reads every leaf within d_k, since its w never
+  drops below d_k (c's new distance and every unchanged point beyond the
+  answer rank after the k-th answer point). So its k best are the true
+  answer: c, beyond d_k at its new place, is not among them.
+
+The counter-decoy is never a trap's point, nor a decoy. The project's test
+``tests/project/test_structure_reads.py`` checks the whole case (traps,
+decoys and counter-decoys) on many random queries: the rule reads on it a
+subset of what it reads on the true tree, and every lawful search answers as
+on the true tree. What a search can still do without the rule: tell a decoy
+pair from a trap by geometry (a decoy's listed leaf lies beyond the k-th
+distance or the radius), which is the rule's own pruning test done on cells.
+
 Margins keep every decision the traps rely on clear of ties (TRAP_MARGIN),
 and the swapped points lie well outside their new cells (SWAP_CLEARANCE), so
 that a filter with a tolerance drops them as well. What answers cannot show:

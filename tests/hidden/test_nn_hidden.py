@@ -21,6 +21,11 @@ reads, so that each is listed under a leaf whose cell it lies outside. A
 search that trusts the tree reads both leaves and answers right; one that
 reads every leaf and drops the points lying outside their leaf's cell (which
 drops every decoy too) loses an answer point, and is told so.
+Some decoys get a partner (:func:`grading.instructors.lying_trees.counter_decoys`):
+a far point of the query's own leaf moved into the decoy's leaf, so that the
+decoy's misplacement is as mutual as a trap's. A search that keeps the
+out-of-cell points swapped both ways (to keep the traps) and drops the rest
+keeps such a decoy, and returns it.
 """
 
 import numpy as np
@@ -171,20 +176,26 @@ def kd_decoy_case(points, leaf_size, seed, k=None, radius=None):
         lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
         lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
-        yield lying_tree, query, lying, decoys, Traps(trapped, apart)
+        lying, partnered, _ = lying_trees.counter_decoys(
+            tree, lying_tree, points, lying, decoys, query, k=k, radius=radius, swapped=trapped
+        )
+        yield lying_tree, query, lying, decoys, Traps(trapped, apart, len(partnered))
 
 
 class Traps:
-    """The swapped points of one query, and whether a swap keeps clear of the query's own leaf."""
+    """The swapped points of one query, whether a swap keeps clear of the query's own leaf, and how many
+    decoys have a partner (:func:`grading.instructors.lying_trees.counter_decoys`)."""
 
-    def __init__(self, points, apart):
-        self.points, self.apart = points, apart
+    def __init__(self, points, apart, partnered=0):
+        self.points, self.apart, self.partnered = points, apart, partnered
 
     @staticmethod
     def count(cases):
-        """Check that a test's queries planted traps, enough to fail a filter that spares its own leaf."""
+        """Check that a test's queries planted traps, enough to fail a filter that spares its own leaf, and
+        decoys with a partner, enough to fail a filter that keeps the points swapped both ways."""
         pairs = sum(len(case.points) // 2 for case in cases)
         assert pairs >= 2 and any(case.apart for case in cases), "the test needs traps on its queries"
+        assert sum(case.partnered for case in cases) >= 2, "the test needs decoys with a partner on its queries"
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -267,7 +278,10 @@ def oc_decoy_case(points, leaf_size, seed, k=None, radius=None):
         lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
         lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
-        yield lying_tree, query, lying, decoys, Traps(trapped, apart)
+        lying, partnered, _ = lying_trees.counter_decoys(
+            tree, lying_tree, points, lying, decoys, query, k=k, radius=radius, swapped=trapped
+        )
+        yield lying_tree, query, lying, decoys, Traps(trapped, apart, len(partnered))
 
 
 @pytest.mark.grades("octree_radius")

@@ -7,7 +7,11 @@ sides of a split; the octree's cube, centre +- extent), and brute-forces the
 rest. On a true tree it drops nothing and answers right; on the structure
 tests' lying trees it drops every planted decoy, which is what made it pass
 before the trap swaps (issue 35). ``own_leaf=True`` keeps the query's own leaf
-unfiltered (the leaf the descent reaches first). Trusted code: only the
+unfiltered (the leaf the descent reaches first). ``mutual=True`` keeps, of the
+points outside their leaf's cell, those swapped both ways (the traps' pattern)
+and drops the one-way ones (the decoys' pattern before the counter-decoys of
+``lying_trees.counter_decoys``); ``mutual="but_its_own_leaf"`` drops the swaps
+through the query's own leaf as well (where the counter-decoys' pairs pass). Trusted code: only the
 project's tests import it, in the grading process.
 """
 
@@ -60,9 +64,81 @@ def _octree_kept(tree, xyz, query, own_leaf):
     return np.array(sorted(kept), dtype=np.int64)
 
 
-def kept_by_cell(tree, points, query, own_leaf=False):
-    """The indices the cheat keeps for one query (k-d tree or octree, by the tree's keys)."""
+def _leaf_cells(tree, width):
+    """Every leaf with its closed cell ``(leaf, lower, upper)``, the bounds widened by the tolerance."""
+    cells, stack = [], [(0, np.full(width, -np.inf), np.full(width, np.inf))]
+    while stack:
+        node, lower, upper = stack.pop()
+        if "axis" in tree:
+            if tree["axis"][node] < 0:
+                cells.append((int(node), lower, upper))
+                continue
+            a, s = tree["axis"][node], tree["split"][node]
+            left_upper, right_lower = upper.copy(), lower.copy()
+            left_upper[a], right_lower[a] = min(upper[a], s), max(lower[a], s)
+            stack += [(int(tree["left"][node]), lower, left_upper), (int(tree["right"][node]), right_lower, upper)]
+            continue
+        children = tree["children"][node]
+        if np.all(children < 0):
+            center, extent = tree["center"][node], tree["extent"][node]
+            cells.append((int(node), center - extent, center + extent))
+            continue
+        stack += [(int(child), None, None) for child in children if child >= 0]
+    widened = []
+    for leaf, lower, upper in cells:
+        finite_lower, finite_upper = np.where(np.isfinite(lower), lower, 0), np.where(np.isfinite(upper), upper, 0)
+        slack = TOLERANCE * (1 + np.abs(finite_lower) + np.abs(finite_upper))
+        widened.append((leaf, lower - slack, upper + slack))
+    return widened
+
+
+def _own(tree, query):
+    """The leaf the descent reaches (None where an octree child is absent)."""
+    node = 0
+    while True:
+        if "axis" in tree:
+            if tree["axis"][node] < 0:
+                return int(node)
+            node = tree["left"][node] if query[tree["axis"][node]] <= tree["split"][node] else tree["right"][node]
+            continue
+        if np.all(tree["children"][node] < 0):
+            return int(node)
+        node = tree["children"][node, int(sum(1 << j for j in range(3) if query[j] > tree["center"][node][j]))]
+        if node < 0:
+            return None
+
+
+def _mutual_kept(tree, points, spare=None):
+    """The hole of issue 35's hostile review (h35, hole 5): every point that lies in its leaf's cell, and of the
+    others those whose misplacement is mutual (some point listed under the leaf it lies in lies in its own
+    leaf: a swap, as the traps are), the one-way ones (the decoys) dropped. With ``spare`` (the query's own
+    leaf), the swaps through it are dropped too (the counter-decoys' pairs all pass through it)."""
+    cells = _leaf_cells(tree, points.shape[1])
+    leaves = np.array([leaf for leaf, _, _ in cells])
+    listed = np.empty(len(points), dtype=np.int64)
+    for leaf in leaves:
+        listed[tree["order"][tree["start"][leaf] : tree["stop"][leaf]]] = leaf
+    inside = np.stack(
+        [np.all((points >= lower) & (points <= upper), axis=1) for _, lower, upper in cells], axis=1
+    )  # (points, leaves)
+    column = {int(leaf): j for j, leaf in enumerate(leaves)}
+    keep = inside[np.arange(len(points)), [column[int(leaf)] for leaf in listed]]
+    lies_in = np.where(inside.any(axis=1), leaves[np.argmax(inside, axis=1)], -1)
+    strays = np.flatnonzero(~keep)
+    edges = {(int(listed[i]), int(lies_in[i])) for i in strays}
+    for i in strays:
+        keep[i] = (int(lies_in[i]), int(listed[i])) in edges and spare not in (int(lies_in[i]), int(listed[i]))
+    return np.flatnonzero(keep).astype(np.int64)
+
+
+def kept_by_cell(tree, points, query, own_leaf=False, mutual=False):
+    """The indices the cheat keeps for one query (k-d tree or octree, by the tree's keys); ``mutual=True``
+    keeps the points swapped both ways as well (:func:`_mutual_kept`)."""
     points = np.asarray(points, dtype=float)
+    if mutual:
+        width = points.shape[1] if "axis" in tree else 3
+        spare = _own(tree, np.asarray(query, dtype=float)[:width]) if mutual == "but_its_own_leaf" else None
+        return _mutual_kept(tree, points[:, :width], spare)
     if "axis" in tree:
         return _kd_kept(tree, points, np.asarray(query, dtype=float), own_leaf)
     return _octree_kept(tree, points[:, :3], np.asarray(query, dtype=float)[:3], own_leaf)
@@ -72,11 +148,11 @@ def _squared(points, indices, query):
     return ((points[indices] - query) ** 2).sum(axis=1)
 
 
-def _knn(tree, points, queries, k, own_leaf, width):
+def _knn(tree, points, queries, k, own_leaf, width, mutual=False):
     points = np.asarray(points, dtype=float)[:, :width]
     rows, dists = [], []
     for query in np.asarray(queries, dtype=float)[:, :width]:
-        kept = kept_by_cell(tree, points, query, own_leaf)
+        kept = kept_by_cell(tree, points, query, own_leaf, mutual)
         s = _squared(points, kept, query)
         rank = np.lexsort((kept, s))[:k]
         rows.append(kept[rank])
@@ -84,11 +160,11 @@ def _knn(tree, points, queries, k, own_leaf, width):
     return np.array(rows, dtype=np.int64).reshape(-1, k), np.array(dists, dtype=float).reshape(-1, k)
 
 
-def _radius(tree, points, queries, radius, own_leaf, width):
+def _radius(tree, points, queries, radius, own_leaf, width, mutual=False):
     points = np.asarray(points, dtype=float)[:, :width]
     rows, dists = [], []
     for query in np.asarray(queries, dtype=float)[:, :width]:
-        kept = kept_by_cell(tree, points, query, own_leaf)
+        kept = kept_by_cell(tree, points, query, own_leaf, mutual)
         s = _squared(points, kept, query)
         inside = s <= radius**2
         rank = np.lexsort((kept[inside], s[inside]))
@@ -98,17 +174,17 @@ def _radius(tree, points, queries, radius, own_leaf, width):
     return indptr, np.concatenate(rows or [np.empty(0, np.int64)]).astype(np.int64), np.concatenate(dists or [[]])
 
 
-def kdtree_knn(tree, points, queries, k, own_leaf=False):
-    return _knn(tree, points, queries, k, own_leaf, np.asarray(points).shape[1])
+def kdtree_knn(tree, points, queries, k, own_leaf=False, mutual=False):
+    return _knn(tree, points, queries, k, own_leaf, np.asarray(points).shape[1], mutual)
 
 
-def kdtree_radius(tree, points, queries, radius, own_leaf=False):
-    return _radius(tree, points, queries, radius, own_leaf, np.asarray(points).shape[1])
+def kdtree_radius(tree, points, queries, radius, own_leaf=False, mutual=False):
+    return _radius(tree, points, queries, radius, own_leaf, np.asarray(points).shape[1], mutual)
 
 
-def octree_knn(tree, points, queries, k, own_leaf=False):
-    return _knn(tree, points, queries, k, own_leaf, 3)
+def octree_knn(tree, points, queries, k, own_leaf=False, mutual=False):
+    return _knn(tree, points, queries, k, own_leaf, 3, mutual)
 
 
-def octree_radius(tree, points, queries, radius, own_leaf=False):
-    return _radius(tree, points, queries, radius, own_leaf, 3)
+def octree_radius(tree, points, queries, radius, own_leaf=False, mutual=False):
+    return _radius(tree, points, queries, radius, own_leaf, 3, mutual)

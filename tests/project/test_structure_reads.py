@@ -8,11 +8,12 @@ reference, the other correct submissions of ``tests/alternatives/``, the
 grader's and the mutants' plain searches, and searches that prune more than
 the rule) and against every way of reading what the rule does not reach
 (brute force, SciPy's cKDTree, reading every leaf and dropping the points that
-lie outside their cells, with or without the query's own leaf): the first
+lie outside their cells, with or without the query's own leaf, or keeping of
+those the ones swapped both ways, as issue 35's hostile review did): the first
 must all pass, the second must all fail, each with its own line. A last test
-checks the lemma behind the traps on many random queries: on the lying tree
-the rule reads a subset of what it reads on the true tree, and every lawful
-search answers as on the true tree.
+checks the lemma behind the traps and the counter-decoys on many random
+queries: on the lying case the rule reads a subset of what it reads on the
+true tree, and every lawful search answers as on the true tree.
 """
 
 import functools
@@ -174,6 +175,11 @@ def cheats(function):
         "scipy cKDTree": (scipy_knn if function.endswith("knn") else scipy_radius, READS),
         "mutant filters_by_cell": (load(mutants / "filters_by_cell.py", function), DROPS),
         "mutant filters_but_its_own_leaf": (load(mutants / "filters_but_its_own_leaf.py", function), DROPS),
+        "mutant keeps_swaps": (load(mutants / "keeps_swaps.py", function), READS),
+        "keeps swaps, but not its own leaf's (this file)": (
+            functools.partial(getattr(_cell_filter, function), mutual="but_its_own_leaf"),
+            DROPS,
+        ),
         "filter, own leaf kept (this file)": (
             functools.partial(getattr(_cell_filter, function), own_leaf=True),
             DROPS,
@@ -224,30 +230,42 @@ CLOUDS = {
 @pytest.mark.parametrize("cloud", CLOUDS)
 @pytest.mark.parametrize("kind", ["kdtree", "octree"])
 def test_on_a_trapped_tree_lawful_searches_read_within_their_reads_and_answer_right(kind, cloud, rng):
+    """On the whole lying case (traps in the tree, decoys and counter-decoys in the cloud), the rule reads
+    a subset of what it reads on the true tree, and every lawful search answers as on the true tree."""
     points = CLOUDS[cloud](rng)
     tree = trees.kdtree(points, 6) if kind == "kdtree" else trees.octree(points, 6, 1e-3)
     searches = {name: search for name, search in lawful(f"{kind}_knn").items() if name != "reference"}
     radius_searches = {name: search for name, search in lawful(f"{kind}_radius").items() if name != "reference"}
-    planted = apart = 0
+    planted = apart = partnered = 0
     for query in rng.uniform(points.min(axis=0), points.max(axis=0), size=(40, 3)):
         for k, radius in ((int(rng.integers(1, 12)), None), (None, float(rng.uniform(0.03, 0.12)))):
             lying, swapped, clear = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
             planted += len(swapped) // 2
             apart += clear
             true_reads = reached_leaves(tree, points, query, k=k, radius=radius)
-            lying_reads = reached_leaves(lying, points, query, k=k, radius=radius)
-            assert lying_reads <= true_reads, "the rule read on a trapped tree a leaf it skips on the true one"
+            nearest = np.sqrt(np.min(trees.squared_distances(points[:, :3], query)))
+            moved, decoys = lying_trees.decoy_points(points, tree, true_reads, query, nearest, rng, radius=radius)
+            moved, paired, counters = lying_trees.counter_decoys(
+                tree, lying, points, moved, decoys, query, k=k, radius=radius, swapped=swapped
+            )
+            partnered += len(paired)
+            lying_reads = reached_leaves(lying, moved, query, k=k, radius=radius)
+            assert lying_reads <= true_reads, "the rule read on a lying tree a leaf it skips on the true one"
             if k is not None:
                 expected = trees.brute_knn(points, query, k)[0]
                 for name, search in searches.items():
-                    assert search(lying, points, query[None], k)[0][0].tolist() == expected.tolist(), name
+                    assert search(lying, moved, query[None], k)[0][0].tolist() == expected.tolist(), name
                 if len(swapped):
-                    assert not np.isin(swapped[0], _cell_filter.kept_by_cell(lying, points, query)), "p is kept"
+                    assert not np.isin(swapped[0], _cell_filter.kept_by_cell(lying, moved, query)), "p is kept"
             else:
                 expected = trees.brute_radius(points, query, radius)[0]
                 for name, search in radius_searches.items():
-                    assert search(lying, points, query[None], radius)[1].tolist() == expected.tolist(), name
+                    assert search(lying, moved, query[None], radius)[1].tolist() == expected.tolist(), name
+            if len(paired):  # the partnered decoys are kept by the filter that keeps mutual swaps
+                assert np.isin(paired, _cell_filter.kept_by_cell(lying, moved, query, mutual=True)).all()
+                assert not np.isin(counters, expected).any()
     assert planted >= 40 and apart >= 20, f"too few traps planted ({planted}, {apart} apart from the own leaf)"
+    assert partnered >= 5, f"too few decoys with a partner ({partnered})"
 
 
 def test_on_trapped_bst_keys_lawful_searches_read_within_their_reads_and_answer_right(rng):
@@ -280,3 +298,76 @@ def test_a_search_that_loses_points_of_its_own_is_not_told_it_filters(function, 
         structure_test(function)(types.SimpleNamespace(**{function: search}))
     except CheckFailed as failed:
         assert DROPS not in failed.rule, failed.rule
+
+
+# -- issue 35's hostile review, hole 5: keep the points swapped both ways ----------------------------
+
+# The attack's cheat as it was submitted (h35-attack, tests/project/test_h35_attack_holes.py): every point
+# but those listed under a leaf whose cell they lie outside, unless the swap is mutual; then brute force.
+H35_CHEAT = """
+import numpy as np
+
+
+def _trusted(tree, points):
+    dim = points.shape[1]
+    boxes, stack = {}, [(0, np.full(dim, -np.inf), np.full(dim, np.inf))]
+    while stack:
+        node, lo, hi = stack.pop()
+        a = tree["axis"][node]
+        if a < 0:
+            boxes[node] = (lo, hi)
+            continue
+        s = tree["split"][node]
+        lhi, rlo = hi.copy(), lo.copy()
+        lhi[a], rlo[a] = min(hi[a], s), max(lo[a], s)
+        stack += [(int(tree["left"][node]), lo, lhi), (int(tree["right"][node]), rlo, hi)]
+    leaves = sorted(boxes)
+    listed = np.empty(len(points), dtype=np.int64)
+    for leaf in leaves:
+        listed[tree["order"][tree["start"][leaf] : tree["stop"][leaf]]] = leaf
+    lows, highs = np.array([boxes[l][0] for l in leaves]), np.array([boxes[l][1] for l in leaves])
+    inside = np.all((points[:, None, :] >= lows[None]) & (points[:, None, :] <= highs[None]), axis=2)
+    lies_in = np.array(leaves)[np.argmax(inside, axis=1)]
+    keep = inside[np.arange(len(points)), np.searchsorted(leaves, listed)]
+    outliers = np.flatnonzero(~keep)
+    pairs = {(int(listed[i]), int(lies_in[i])) for i in outliers}
+    for i in outliers:
+        keep[i] = (int(lies_in[i]), int(listed[i])) in pairs
+    return np.flatnonzero(keep)
+
+
+def kdtree_knn(tree, points, queries, k):
+    points, queries = np.asarray(points, dtype=float), np.asarray(queries, dtype=float)
+    keep = _trusted(tree, points)
+    indices, distances = np.empty((len(queries), k), dtype=np.int64), np.empty((len(queries), k))
+    for j, q in enumerate(queries):
+        s = ((points[keep] - q) ** 2).sum(axis=1)
+        rank = np.lexsort((keep, s))[:k]
+        indices[j], distances[j] = keep[rank], np.sqrt(s[rank])
+    return indices, distances
+
+
+def kdtree_radius(tree, points, queries, radius):
+    points, queries = np.asarray(points, dtype=float), np.asarray(queries, dtype=float)
+    keep = _trusted(tree, points)
+    rows = []
+    for q in queries:
+        s = ((points[keep] - q) ** 2).sum(axis=1)
+        inside = np.flatnonzero(s <= radius**2)
+        rows.append(inside[np.lexsort((keep[inside], s[inside]))])
+    indptr = np.concatenate([[0], np.cumsum([len(r) for r in rows])]).astype(np.int64)
+    chosen = [keep[r] for r in rows]
+    distances = [np.sqrt(((points[c] - q) ** 2).sum(axis=1)) for c, q in zip(chosen, queries)]
+    return indptr, np.concatenate(chosen).astype(np.int64), np.concatenate(distances)
+"""
+
+
+@pytest.mark.parametrize("function", ["kdtree_knn", "kdtree_radius"])
+def test_h35_hole_5_a_filter_that_keeps_the_mutual_swaps_returns_a_partnered_decoy(function):
+    """The attack's cheat scored full marks when the traps were the only misplacements swapped both ways
+    (b5918c2); the counter-decoys give some decoys a partner, and it returns one of them."""
+    module = types.ModuleType("_h35_cheat")
+    exec(compile(H35_CHEAT, "<h35 cheat>", "exec"), module.__dict__)
+    with pytest.raises(CheckFailed) as failed:
+        structure_test(function)(types.SimpleNamespace(**{function: getattr(module, function)}))
+    assert failed.value.rule == f"{function} {READS}"

@@ -26,7 +26,6 @@ FILTERS_BY_CELL = (
     "the contract says to trust the tree; read only what the rule reaches, and keep every point you read"
 )
 
-
 DROPS_ZERO = (
     "keep every point with squared distance <= r ** 2, 0 included: the query itself and its duplicates "
     "are neighbours (a test 0 < s, or skipping the query's own index, drops them)"
@@ -53,16 +52,26 @@ def _finite_sentinel(search, squared):
     )
 
 
-def _cell_filtered(case, tree, points, queries, **argument):
-    """The cell-filter cheat on one search's arguments: every leaf, or every leaf but the query's own, filtered."""
-    tree, points, queries = case(tree, points, queries)
-    if "k" in argument:
-        argument = {"k": _k_of(argument["k"], len(points))}
-    else:
-        argument = {"radius": _radius_of(argument["radius"])}
-    return Variants(
-        tree_searches.cell_filtered_search(tree, points, queries, own_leaf=own, **argument) for own in (False, True)
-    )
+KEEPS_SWAPS = (
+    "your search checks whether points lie in their node's cell, and keeps those listed elsewhere only when "
+    "they are swapped both ways: the contract says to trust the tree; read only what the rule reaches, and "
+    "keep every point you read"
+)
+
+
+def _cell_filters(case, mutual=False):
+    """The cell-filter cheat as one search's prediction: every leaf, or every leaf but the query's own,
+    filtered; ``mutual``: the points swapped both ways kept (issue 35's hostile review, hole 5)."""
+
+    def predict(tree, points, queries, k=None, radius=None):
+        tree, points, queries = case(tree, points, queries)
+        argument = {"k": _k_of(k, len(points))} if radius is None else {"radius": _radius_of(radius)}
+        if mutual:
+            return tree_searches.cell_filtered_search(tree, points, queries, mutual=True, **argument)
+        owns = (False, True)
+        return Variants(tree_searches.cell_filtered_search(tree, points, queries, own_leaf=o, **argument) for o in owns)
+
+    return predict
 
 
 def _k_of(k, n):
@@ -350,12 +359,9 @@ KDTREE_KNN = Model(
             "worst distance, not when |q[axis] - split| <= w2",
             lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, unsquared=True),
         ),
-        Mistake(
-            "filters_by_cell",
-            FILTERS_BY_CELL,
-            lambda tree, points, queries, k: _cell_filtered(_kd_case, tree, points, queries, k=k),
-        ),
+        Mistake("filters_by_cell", FILTERS_BY_CELL, _cell_filters(_kd_case)),
         Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(kdtree_knn, squared=True)),
+        Mistake("keeps_swaps", KEEPS_SWAPS, _cell_filters(_kd_case, mutual=True)),
     ),
 )
 
@@ -379,16 +385,13 @@ KDTREE_RADIUS = Model(
                 for prune in (False, True)
             ),
         ),
-        Mistake(
-            "filters_by_cell",
-            FILTERS_BY_CELL,
-            lambda tree, points, queries, radius: _cell_filtered(_kd_case, tree, points, queries, radius=radius),
-        ),
+        Mistake("filters_by_cell", FILTERS_BY_CELL, _cell_filters(_kd_case)),
         Mistake(
             "drops_zero",
             DROPS_ZERO,
             lambda tree, points, queries, radius: kdtree_radius(tree, points, queries, radius, drop_zero=True),
         ),
+        Mistake("keeps_swaps", KEEPS_SWAPS, _cell_filters(_kd_case, mutual=True)),
     ),
 )
 
@@ -519,11 +522,7 @@ OCTREE_RADIUS = Model(
             "a return or break there loses the leaf's later points",
             lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, stop_at_miss=True),
         ),
-        Mistake(
-            "filters_by_cell",
-            FILTERS_BY_CELL,
-            lambda tree, points, queries, radius: _cell_filtered(_octree_case, tree, points, queries, radius=radius),
-        ),
+        Mistake("filters_by_cell", FILTERS_BY_CELL, _cell_filters(_octree_case)),
         Mistake(
             "unclamped_gap",
             UNCLAMPED_GAP,
@@ -537,6 +536,7 @@ OCTREE_RADIUS = Model(
                 for contains in (True, False)
             ),
         ),
+        Mistake("keeps_swaps", KEEPS_SWAPS, _cell_filters(_octree_case, mutual=True)),
     ),
 )
 
@@ -566,11 +566,8 @@ OCTREE_KNN = Model(
             "a centre plane belongs to the lower octant and can lie on its face at exactly the k-th distance",
             lambda tree, points, queries, k: octree_knn(tree, points, queries, k, strict=True),
         ),
-        Mistake(
-            "filters_by_cell",
-            FILTERS_BY_CELL,
-            lambda tree, points, queries, k: _cell_filtered(_octree_case, tree, points, queries, k=k),
-        ),
+        Mistake("filters_by_cell", FILTERS_BY_CELL, _cell_filters(_octree_case)),
+        Mistake("keeps_swaps", KEEPS_SWAPS, _cell_filters(_octree_case, mutual=True)),
         Mistake(
             "unclamped_gap",
             UNCLAMPED_GAP,
