@@ -293,7 +293,14 @@ def check_csr(result, expected_rows, what="radius search"):
         got = indices[indptr[i] : indptr[i + 1]]
         if not np.array_equal(got, rows):
             missing = np.setdiff1d(rows, got)
-            if set(got.tolist()) == set(rows.tolist()):
+            own = dict(zip(rows.tolist(), dists.tolist()))  # each expected neighbour's own distance
+            reported = distances[indptr[i] : indptr[i + 1]]
+            if set(got.tolist()) == set(rows.tolist()) and not np.allclose(
+                reported, [own[j] for j in got.tolist()], rtol=1e-9, atol=1e-12
+            ):
+                hint = "the right neighbours with distances not their own: report each point's own distance "
+                hint += "(a contained octant's points too), then sort each row by (distance, index)"
+            elif set(got.tolist()) == set(rows.tolist()):
                 hint = "the right neighbours in another order: sort each row by (squared distance, index)"
             elif len(missing) and np.all(dists[np.isin(rows, missing)] == 0):
                 hint = (

@@ -122,6 +122,7 @@ def octree_search(
     sentinel=None,
     drop_zero=False,
     unclamped=False,
+    contained_at_radius=False,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -136,7 +137,9 @@ def octree_search(
     ``drop_zero`` (radius: a leaf's point only if ``0 < s``; a contained
     octant's points are reported without a test, so kept), ``unclamped`` (a
     cube's distance as sum_j (|q_j - c_j| - e) ** 2, each axis's gap not
-    clamped at 0: an axis where the query lies within the cube adds to it).
+    clamped at 0: an axis where the query lies within the cube adds to it),
+    ``contained_at_radius`` (a contained octant's points reported at distance
+    r, not their own).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -163,6 +166,8 @@ def octree_search(
                 keep = np.ones(len(s), dtype=bool) if everything else (s <= radius**2) & ((s > 0) | (not drop_zero))
                 if stop_at_miss and not keep.all():
                     keep[np.argmin(keep) :] = False
+                if everything and contained_at_radius:
+                    s = np.full(len(s), radius**2)
                 found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
 
         def radius_visit(node, query=query):

@@ -154,6 +154,7 @@ def _octree_search(
     sentinel=None,
     drop_zero=False,
     unclamped=False,
+    contained_at_radius=False,
 ):
     held = _slots(k, sentinel) if k is not None else []  # (squared distance, index), sorted
 
@@ -168,6 +169,8 @@ def _octree_search(
             s = float(np.sum((xyz[index] - query) ** 2))
             if k is not None:
                 held = sorted([*held, (s, int(index))])[:k]
+            elif everything and contained_at_radius:  # every point of a contained octant "at the radius"
+                held.append((radius**2, int(index)))
             elif everything or (s <= radius**2 and (s > 0 or not drop_zero)):
                 held.append((s, int(index)))
             elif stop_at_miss:  # the leaf's later points are never tested
@@ -222,11 +225,12 @@ def octree_radius(
     stop_at_miss=False,
     drop_zero=False,
     unclamped=False,
+    contained_at_radius=False,
 ):
     """CSR rows of a plain recursive octree search (with the contains shortcut by default); ``drop_zero``:
     a leaf's points at distance 0 are dropped (a contained octant's are reported untested)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (contains, False, True, box, strict, stop_at_miss, None, drop_zero, unclamped)
+    flags = (contains, False, True, box, strict, stop_at_miss, None, drop_zero, unclamped, contained_at_radius)
     rows = [_octree_search(tree, xyz, q[:3], None, radius, *flags) for q in np.asarray(queries, dtype=float)]
     return _csr_arrays(rows)
 

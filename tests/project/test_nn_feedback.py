@@ -176,3 +176,12 @@ def test_the_box_overlap_and_unclamped_gap_entries_describe_opposite_mistakes():
         messages = {mistake.id: mistake.message for mistake in model.mistakes}
         assert "clamp each axis's gap at 0" in messages["unclamped_gap"]
     assert "too weak" in {m.id: m.message for m in nn.OCTREE_RADIUS.mistakes}["box_overlap"]
+
+
+def test_a_radius_row_with_distances_not_their_own_says_so():
+    # A contained octant's points reported at distance r: the right set, sorted wrong, and the hint
+    # "sort each row by (squared distance, index)" sent the student to the sort.
+    rows = [(np.array([3, 1, 2]), np.array([0.1, 0.2, 0.3]))]
+    result = (np.array([0, 3]), np.array([3, 2, 1]), np.array([0.1, 0.5, 0.5]))
+    text = failure(check_csr, result, rows)
+    assert "distances not their own" in text and "(a contained octant's points too)" in text

@@ -522,6 +522,14 @@ OCTREE_RADIUS = Model(
             "a return or break there loses the leaf's later points",
             lambda tree, points, queries, radius: octree_radius(tree, points, queries, radius, stop_at_miss=True),
         ),
+        Mistake(
+            "contained_at_radius",
+            "report a contained octant's points with their own distances (the shortcut skips the test s <= r ** 2, "
+            "not the distance), then sort each row by (distance, index)",
+            lambda tree, points, queries, radius: octree_radius(
+                tree, points, queries, radius, contained_at_radius=True
+            ),
+        ),
         Mistake("filters_by_cell", FILTERS_BY_CELL, _cell_filters(_octree_case)),
         Mistake(
             "unclamped_gap",
