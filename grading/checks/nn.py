@@ -205,6 +205,12 @@ def check_octree(tree, points, leaf_size, min_extent):
             if not np.all(np.diff(order[lo:hi]) > 0):
                 _fail(f"leaf {node}: its points must be in increasing index, got {order[lo:hi][:6]}", "leaf order")
             return
+        if np.all(children == -1):
+            _fail(
+                f"node {node} holds {hi - lo} > leaf_size = {leaf_size} points and its extent {extent:g} is above "
+                f"min_extent = {min_extent:g}: it must be split, its children array holding the ids of its octants",
+                "a big node is a leaf",
+            )
         indices = order[lo:hi]
         codes = (xyz[indices, 0] > center[0]) + 2 * (xyz[indices, 1] > center[1]) + 4 * (xyz[indices, 2] > center[2])
         if np.any(np.diff(codes) < 0):

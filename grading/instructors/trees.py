@@ -240,12 +240,20 @@ def kdtree(
     }
 
 
-def octree(points, leaf_size, min_extent):
-    """The contract's bucket PR octree (preorder, children in code order) as its dict."""
+def octree(points, leaf_size, min_extent, root="bbox", plane="lower", linked=True):
+    """The contract's bucket PR octree (preorder, children in code order) as its dict.
+
+    The other values give known wrong builds: ``root="mean"`` (the root cube
+    around the points' mean, with the bounding box's half side),
+    ``plane="upper"`` (a point on a centre plane goes to the upper child),
+    ``linked=False`` (every node's children left at -1, though built).
+    """
     xyz = np.asarray(points, dtype=float)[:, :3]
     if len(xyz):
         lower, upper = xyz.min(axis=0), xyz.max(axis=0)
         root_center, root_extent = (lower + upper) / 2, float(np.max((upper - lower) / 2))
+        if root == "mean":
+            root_center = xyz.mean(axis=0)
     else:
         root_center, root_extent = np.zeros(3), 0.0
     nodes = []  # [start, stop, center, extent, children]
@@ -259,11 +267,12 @@ def octree(points, leaf_size, min_extent):
         else:
             codes = {}
             for i in indices:
-                code = sum(1 << j for j in range(3) if xyz[i, j] > center[j])
-                codes.setdefault(code, []).append(i)
+                above = xyz[i] >= center if plane == "upper" else xyz[i] > center
+                codes.setdefault(int(sum(1 << j for j in range(3) if above[j])), []).append(i)
             for code in sorted(codes):
                 signs = np.array([1.0 if code >> j & 1 else -1.0 for j in range(3)])
-                nodes[node][4][code] = grow(codes[code], center + signs * extent / 2, extent / 2)
+                child = grow(codes[code], center + signs * extent / 2, extent / 2)
+                nodes[node][4][code] = child if linked else -1
         nodes[node][1] = len(order)
         return node
 

@@ -185,3 +185,14 @@ def test_a_radius_row_with_distances_not_their_own_says_so():
     result = (np.array([0, 3]), np.array([3, 2, 1]), np.array([0.1, 0.5, 0.5]))
     text = failure(check_csr, result, rows)
     assert "distances not their own" in text and "(a contained octant's points too)" in text
+
+
+def test_an_octree_whose_nodes_have_no_children_is_told_to_split_them():
+    # It was told "node 0: its points must be grouped by child code", pointing at the code formula.
+    from grading.checks.nn import check_octree
+    from grading.instructors import trees
+
+    points = np.random.default_rng(4).uniform(-1, 1, (1000, 3))
+    text = failure(check_octree, trees.octree(points, 8, 1e-3, linked=False), points, 8, 1e-3)
+    assert text.startswith("node 0 holds 1000 > leaf_size = 8 points and its extent"), text
+    assert "it must be split" in text

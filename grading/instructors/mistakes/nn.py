@@ -399,52 +399,13 @@ KDTREE_RADIUS = Model(
 # -- octree ---------------------------------------------------------------------------------------
 
 
-def octree_build(points, leaf_size=8, min_extent=1e-3, root="bbox", plane="lower"):
+def octree_build(points, leaf_size=8, min_extent=1e-3, **changes):
     points = valid_points(points, min_columns=3)
     if not isinstance(leaf_size, (int, np.integer)) or leaf_size < 1:
         raise ValueError("leaf_size")
     if not isinstance(min_extent, (int, float, np.floating)) or not math.isfinite(min_extent) or min_extent <= 0:
         raise ValueError("min_extent")
-    if root == "bbox" and plane == "lower":
-        return trees.octree(points, int(leaf_size), float(min_extent))
-    xyz = points[:, :3]
-    if len(xyz) == 0:
-        return None
-    lower, upper = xyz.min(axis=0), xyz.max(axis=0)
-    extent = float(np.max((upper - lower) / 2))
-    if root == "mean":  # the bounding box's half side, around the mean
-        return _grow_from(xyz, int(leaf_size), float(min_extent), xyz.mean(axis=0), extent)
-    return _grow_from(xyz, int(leaf_size), float(min_extent), (lower + upper) / 2, extent, upper_on_plane=True)
-
-
-def _grow_from(xyz, leaf_size, min_extent, root_center, root_extent, upper_on_plane=False):
-    nodes, order = [], []
-
-    def grow(indices, center, extent):
-        node = len(nodes)
-        nodes.append([len(order), None, center, extent, [-1] * 8])
-        if len(indices) <= leaf_size or extent <= min_extent:
-            order.extend(sorted(indices))
-        else:
-            groups = {}
-            for i in indices:
-                above = (xyz[i] >= center) if upper_on_plane else (xyz[i] > center)
-                groups.setdefault(int(sum(1 << j for j in range(3) if above[j])), []).append(i)
-            for code in sorted(groups):
-                signs = np.array([1.0 if code >> j & 1 else -1.0 for j in range(3)])
-                nodes[node][4][code] = grow(groups[code], center + signs * extent / 2, extent / 2)
-        nodes[node][1] = len(order)
-        return node
-
-    grow(list(range(len(xyz))), np.asarray(root_center, dtype=float), float(root_extent))
-    return {
-        "order": np.array(order, dtype=np.int64),
-        "start": np.array([n[0] for n in nodes], dtype=np.int64),
-        "stop": np.array([n[1] for n in nodes], dtype=np.int64),
-        "center": np.array([n[2] for n in nodes], dtype=float).reshape(-1, 3),
-        "extent": np.array([n[3] for n in nodes], dtype=float),
-        "children": np.array([n[4] for n in nodes], dtype=np.int64).reshape(-1, 8),
-    }
+    return trees.octree(points, int(leaf_size), float(min_extent), **changes)
 
 
 OCTREE_BUILD = Model(
@@ -460,6 +421,12 @@ OCTREE_BUILD = Model(
             "upper_on_plane",
             "a point on a centre plane goes to the LOWER child: the code uses strict x > cx (and y, z)",
             lambda points, leaf_size=8, min_extent=1e-3: octree_build(points, leaf_size, min_extent, plane="upper"),
+        ),
+        Mistake(
+            "children_unlinked",
+            "a node of more than leaf_size points is split: its children array must hold the ids the recursion "
+            "returns (here no node has a child, though the children were built: a list rebound, not filled)",
+            lambda points, leaf_size=8, min_extent=1e-3: octree_build(points, leaf_size, min_extent, linked=False),
         ),
     ),
 )
