@@ -45,9 +45,11 @@ ASSIGNMENTS = {
 GRADED_FUNCTIONS = {function: module for graded in ASSIGNMENTS.values() for function, module in graded.items()}
 EXERCISE_MODULES = tuple(dict.fromkeys(GRADED_FUNCTIONS.values()))  # pcl_course/<module>.py
 ASSIGNMENT_MODULES = {name: tuple(dict.fromkeys(graded.values())) for name, graded in ASSIGNMENTS.items()}
-# A graded function's place in its own assignment (1, 2, ...): Gradescope numbers a test
-# "<function's place>.<test's place>", so that each assignment's tests start at 1.1.
+# A graded function's place in its own assignment (1, 2, ...), and its assignment's: Gradescope
+# numbers a test "<function's place>.<test's place>", so that each assignment's tests start at 1.1;
+# a run over several assignments (the whole course, locally) prefixes the assignment's place.
 FUNCTION_NUMBERS = {function: i + 1 for graded in ASSIGNMENTS.values() for i, function in enumerate(graded)}
+ASSIGNMENT_NUMBERS = {function: i + 1 for i, graded in enumerate(ASSIGNMENTS.values()) for function in graded}
 # The course's title and its lectures' short titles (their parts of the book,
 # _toc.yml), one per assignment, in order. The book (_config.yml's title, the
 # part captions), pcl_course/__init__.py's docstring (its exercise modules by

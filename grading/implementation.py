@@ -93,6 +93,19 @@ def argument_names(function, paths):
     return sorted(names)
 
 
+def _raised_in(exc, impl):
+    """Whether ``exc`` was raised by a statement of the implementation (or of the course's own package,
+    whose validation helpers it may call), not inside a library."""
+    tb = exc.__traceback__
+    while tb is not None and tb.tb_next is not None:
+        tb = tb.tb_next
+    if tb is None:
+        return False
+    path = Path(tb.tb_frame.f_code.co_filename)
+    roots = [impl.directory, *impl.overrides.values(), REPO_ROOT / "pcl_course"]
+    return any(path == root or root in path.parents for root in roots)
+
+
 def _where_in(exc, impl):
     """file:line of the innermost frame of the implementation in ``exc``'s traceback."""
     roots = [impl.directory, *impl.overrides.values()]
@@ -233,6 +246,8 @@ class Implementation:
                 call.error_type = type(exc).__name__
                 call.error = (str(exc).splitlines() or [""])[0][:200]
                 call.where = getattr(exc, "where", None) or _where_in(exc, self)
+                if not hasattr(exc, "raised_by_submission"):
+                    exc.raised_by_submission = _raised_in(exc, self)
                 modified = getattr(exc, "modified", [])
                 raise
             finally:

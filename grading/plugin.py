@@ -231,15 +231,19 @@ def _new_result(item, number):
 def pytest_collection_finish(session):
     """Every graded test gets its result now, as not run, numbered
     ``<function>.<test>``, the function's place in its own assignment (so that
-    lecture 2 starts at 1.1, as lecture 1 does): a run killed later still
-    leaves a complete, valid results file."""
+    lecture 2 starts at 1.1, as lecture 1 does; a run over both lectures
+    prefixes the lecture's place): a run killed later still leaves a
+    complete, valid results file."""
     results = session.config.stash[_RESULTS_KEY]
+    graded = [item for item in session.items if _is_graded(item) and graded_function(item) in GRADED_FUNCTIONS]
+    several = len({grading_config.ASSIGNMENT_NUMBERS[graded_function(item)] for item in graded}) > 1
     counts = {}
-    for item in session.items:
+    for item in graded:  # unmarked ones stopped the run already
         function = graded_function(item)
-        if _is_graded(item) and function in GRADED_FUNCTIONS:  # unmarked ones stopped the run already
-            counts[function] = counts.get(function, 0) + 1
-            results[item.nodeid] = _new_result(item, f"{grading_config.FUNCTION_NUMBERS[function]}.{counts[function]}")
+        counts[function] = counts.get(function, 0) + 1
+        number = f"{grading_config.FUNCTION_NUMBERS[function]}.{counts[function]}"
+        prefix = f"{grading_config.ASSIGNMENT_NUMBERS[function]}." if several else ""
+        results[item.nodeid] = _new_result(item, prefix + number)
     session.config.stash[_STARTED_KEY] = time.monotonic()
     _write_results(session.config, final=False)
 

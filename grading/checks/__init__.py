@@ -185,6 +185,12 @@ class raises:
         if issubclass(kind, self.expected):
             self.value = value
             if self.naming is not None and self.naming not in str(value):
+                if not getattr(value, "raised_by_submission", True):
+                    raise CheckFailed(
+                        f"the {kind.__name__} came from inside a library ({_clipped(str(value))!r}), not from a "
+                        f"check of your own: check the input first and raise ValueError naming {self.naming!r}",
+                        rule="a library's error, not a check of the input",
+                    ) from None
                 raise CheckFailed(
                     f"the {kind.__name__} must name the bad argument, {self.naming!r}; its message was: "
                     f"{_clipped(str(value))!r}",

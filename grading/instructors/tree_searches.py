@@ -123,6 +123,7 @@ def octree_search(
     drop_zero=False,
     unclamped=False,
     contained_at_radius=False,
+    code_from_x=False,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -139,7 +140,8 @@ def octree_search(
     cube's distance as sum_j (|q_j - c_j| - e) ** 2, each axis's gap not
     clamped at 0: an axis where the query lies within the cube adds to it),
     ``contained_at_radius`` (a contained octant's points reported at distance
-    r, not their own).
+    r, not their own), ``code_from_x`` (kNN: the query's own child code
+    computed with x for all three bits, so 0 or 7).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -187,7 +189,7 @@ def octree_search(
             if is_octree_leaf(tree, node):
                 offer(node)
             else:
-                own = sum(1 << j for j in range(3) if query[j] > c[j])
+                own = sum(1 << j for j in range(3) if query[0 if code_from_x else j] > c[0 if code_from_x else j])
                 codes = [own] + [i for i in range(8) if i != own] if own_first else list(range(8))
                 for code in codes:
                     child = tree["children"][node, code]

@@ -556,5 +556,6 @@ def _exception(answer):
         except TypeError:  # a builtin whose constructor wants more (UnicodeDecodeError, ...)
             return SandboxError(f"raised {kind}: {message}{shown}", kind=RAISED)
         exc.where = where
+        exc.raised_by_submission = answer.get("own") is True
         return exc
     return SandboxError(f"raised {kind}: {message}{shown}", kind=RAISED)

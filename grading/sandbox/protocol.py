@@ -24,7 +24,9 @@ Answers (worker to grader, on a private copy of the worker's stdout)
       "where"}``, so that a module that cannot be imported is told apart
       from a function that fails;
     * then the call's answer: ``{"ok": true, "value": node}`` or the
-      failure ``{"ok": false, "type", "builtin", "message", "where"}``, each
+      failure ``{"ok": false, "type", "builtin", "message", "where", "own"}``
+      (``own``: raised by a statement of the submission's package, not
+      inside a library; it words the feedback, never a mark), each
       with ``"modified"``: ``[{"path": [...]}]`` per argument the call
       changed in place (``["args", 0]``, ``["kwargs", "name"]``), with
       ``"state"`` for a random generator (its new bit-generator state).

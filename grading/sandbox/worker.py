@@ -153,12 +153,15 @@ def _where(exc):
 
 
 def _failure(exc):
+    frames = traceback.extract_tb(exc.__traceback__)
     return {
         "ok": False,
         "type": type(exc).__name__,
         "builtin": type(exc).__module__ == "builtins",
         "message": str(exc)[:2000],
         "where": _where(exc),
+        # raised by a statement of the submission's own package (a check of its own), not inside a library
+        "own": bool(frames) and "pcl_course" in frames[-1].filename,
     }
 
 

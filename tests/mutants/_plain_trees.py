@@ -155,6 +155,7 @@ def _octree_search(
     drop_zero=False,
     unclamped=False,
     contained_at_radius=False,
+    code_from_x=False,
 ):
     held = _slots(k, sentinel) if k is not None else []  # (squared distance, index), sorted
 
@@ -192,7 +193,8 @@ def _octree_search(
         if np.all(children < 0):
             offer(node)
         else:
-            own = int(sum(1 << j for j in range(3) if query[j] > center[j]))
+            axes = [0, 0, 0] if code_from_x else [0, 1, 2]  # the copy-and-paste slip: x for every bit
+            own = int(sum(1 << j for j, a in enumerate(axes) if query[a] > center[a]))
             codes = [own] + [c for c in range(8) if c != own] if own_first else list(range(8))
             for code in codes:
                 if children[code] >= 0 and meets(children[code]) and visit(children[code]):
@@ -204,12 +206,22 @@ def _octree_search(
 
 
 def octree_knn(
-    tree, points, queries, k, early=True, own_first=True, box=False, strict=False, sentinel=None, unclamped=False
+    tree,
+    points,
+    queries,
+    k,
+    early=True,
+    own_first=True,
+    box=False,
+    strict=False,
+    sentinel=None,
+    unclamped=False,
+    code_from_x=False,
 ):
     """kNN rows of a plain recursive octree search (Behley's order and early termination by default);
     ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (True, early, own_first, box, strict, False, sentinel, False, unclamped)
+    flags = (True, early, own_first, box, strict, False, sentinel, False, unclamped, False, code_from_x)
     rows = [_octree_search(tree, xyz, q[:3], k, None, *flags) for q in np.asarray(queries, dtype=float)]
     return _knn_arrays(rows, k)
 

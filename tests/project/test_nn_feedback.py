@@ -7,6 +7,7 @@ reads the text the student would read.
 import numpy as np
 import pytest
 
+from grading import REPO_ROOT
 from grading.checks.nn import check_csr, check_knn
 from grading.errors import CheckFailed
 
@@ -196,3 +197,23 @@ def test_an_octree_whose_nodes_have_no_children_is_told_to_split_them():
     text = failure(check_octree, trees.octree(points, 8, 1e-3, linked=False), points, 8, 1e-3)
     assert text.startswith("node 0 holds 1000 > leaf_size = 8 points and its extent"), text
     assert "it must be split" in text
+
+
+def test_a_run_over_both_lectures_numbers_each_test_uniquely(tmp_path):
+    from _helpers import run_grader
+
+    summary, _ = run_grader("--reference", "--function", "pca", "--function", "knn_result_set", tmp_path=tmp_path)
+    numbers = [test["number"] for test in summary["tests"]]
+    assert len(set(numbers)) == len(numbers) and {n.split(".")[0] for n in numbers} == {"1", "2"}, numbers
+
+
+def test_a_library_error_is_not_taken_for_a_check_naming_another_argument(tmp_path):
+    # A pca without checks raised NumPy's LinAlgError (a ValueError): it was told its error "names another
+    # argument", though no check of its own ran.
+    from _helpers import run_grader
+
+    mutant = REPO_ROOT / "tests" / "mutants" / "pca" / "no_validation.py"
+    arguments = ("--reference", "--impl-module", f"pca={mutant}", "-k", "test_pca_rejects_bad_points")
+    summary, _ = run_grader(*arguments, tmp_path=tmp_path)
+    diagnoses = summary["extra_data"]["diagnoses"]
+    assert diagnoses["pca"]["id"] == "did_not_raise", diagnoses

@@ -549,6 +549,12 @@ OCTREE_KNN = Model(
             lambda tree, points, queries, k: octree_knn(tree, points, queries, k, unclamped=True),
         ),
         Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(octree_knn, squared=True)),
+        Mistake(
+            "code_from_x",
+            "the query's own child code takes one bit per axis: (q_x > c_x) + 2 (q_y > c_y) + 4 (q_z > c_z); with x "
+            "for every bit the search starts in the wrong octant and reads octants its rule never reaches",
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, code_from_x=True),
+        ),
     ),
 )
 
