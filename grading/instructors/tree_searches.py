@@ -56,6 +56,7 @@ def kdtree_search(
     unsquared=False,
     sentinel=None,
     drop_zero=False,
+    misindented=False,
 ):
     """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -64,7 +65,10 @@ def kdtree_search(
     ``far_first``, ``prune=False`` (every leaf), ``unsquared`` (the far child
     if ``|d| <= w2``: a distance against a squared one), ``sentinel`` (kNN:
     the worst squared distance starts at this finite value, :func:`_best`),
-    ``drop_zero`` (radius: a point only if ``0 < s``, the query's duplicates lost).
+    ``drop_zero`` (radius: a point only if ``0 < s``, the query's duplicates lost),
+    ``misindented`` (kNN: a published homework's if/else, the pruning ``if``
+    dedented out of the query-left branch: a query right of a split never
+    reaches the left child; a query left of it reads the right one always).
     """
     points = np.asarray(points, dtype=float)
     queries = _as_rows(queries, points.shape[1])
@@ -91,6 +95,17 @@ def kdtree_search(
                     found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
                 return
             diff = query[tree["axis"][node]] - tree["split"][node]
+            if misindented:
+                left, right = tree["left"][node], tree["right"][node]
+                if diff <= 0:
+                    visit(left)
+                if diff * diff < best.worst:
+                    visit(right)
+                else:
+                    visit(right)
+                    if diff * diff < best.worst:
+                        visit(left)
+                return
             near, far = (
                 (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
             )

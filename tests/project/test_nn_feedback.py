@@ -217,3 +217,13 @@ def test_a_library_error_is_not_taken_for_a_check_naming_another_argument(tmp_pa
     summary, _ = run_grader(*arguments, tmp_path=tmp_path)
     diagnoses = summary["extra_data"]["diagnoses"]
     assert diagnoses["pca"]["id"] == "did_not_raise", diagnoses
+
+
+def test_the_published_homeworks_misindented_search_is_in_the_catalogue():
+    # A real student's k-d search got "40 of 60 rows differ" and a generic hint; its mutant now declares
+    # the catalogue entry it must get (test_grading.py checks the diagnosis).
+    from grading.instructors.mistakes import nn
+
+    assert "misindented_else" in {mistake.id for mistake in nn.KDTREE_KNN.mistakes}
+    source = (REPO_ROOT / "tests" / "mutants" / "kdtree_knn" / "misindented_else.py").read_text()
+    assert 'MISTAKE = "misindented_else"' in source

@@ -361,6 +361,12 @@ KDTREE_KNN = Model(
         ),
         Mistake("filters_by_cell", FILTERS_BY_CELL, _cell_filters(_kd_case)),
         Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(kdtree_knn, squared=True)),
+        Mistake(
+            "misindented_else",
+            "a query right of a split never reaches the left child: check the if/else indentation; each branch "
+            "visits its near child, then the far one when (q[axis] - split) ** 2 <= w2",
+            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, misindented=True),
+        ),
         Mistake("keeps_swaps", KEEPS_SWAPS, _cell_filters(_kd_case, mutual=True)),
     ),
 )

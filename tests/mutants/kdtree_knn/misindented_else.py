@@ -7,7 +7,7 @@ import numpy as np
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import kdtree_knn as _reference
 
-MISTAKE = None  # no diagnosis of its own: the brute-force tests' rows say what is wrong
+MISTAKE = "misindented_else"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def _search(tree, points, query, k, radius):
