@@ -255,48 +255,59 @@ def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=Fa
     trees it drops the decoys and the trapped points, or (``mutual``) keeps
     the trapped points and the decoys that have a partner
     (:func:`lying_trees.counter_decoys`).
+
+    What the cheat keeps does not depend on the query but for its own leaf:
+    it is worked out once per tree, every point against every cell at once.
     """
     points = np.asarray(points, dtype=float)
     width = points.shape[1] if "axis" in tree else 3
     points = points[:, :width]
+    leaves, lower, upper = _leaf_cells(tree, width)
+    listed = [tree["order"][tree["start"][leaf] : tree["stop"][leaf]] for leaf in leaves]
+    entry_cell = np.repeat(np.arange(len(leaves)), [len(indices) for indices in listed])
+    entry_index = np.concatenate(listed).astype(np.int64) if listed else np.empty(0, np.int64)
+    inside = _in_cells(points[entry_index], lower[entry_cell], upper[entry_cell])
+    kept = entry_index[inside]
+    if mutual:
+        strays = entry_index[~inside]
+        holds = _in_cells(points[strays, None, :], lower[None], upper[None])  # (strays, cells)
+        lies_in = np.where(holds.any(axis=1), np.argmax(holds, axis=1), -1)
+        listed_under = entry_cell[~inside]
+        edges = set(zip(listed_under.tolist(), lies_in.tolist()))
+        swapped = [(cell, under) in edges for under, cell in zip(listed_under.tolist(), lies_in.tolist())]
+        kept = np.concatenate([kept, strays[np.array(swapped, dtype=bool)]])
+    cell_of = {leaf: j for j, leaf in enumerate(leaves)}
     rows = []
-    for query in np.asarray(queries, dtype=float).reshape(-1, np.asarray(queries).shape[-1])[:, :width]:
-        walk = lying_trees.leaf_walk(tree, query)
+    for query in _as_rows(queries, np.asarray(queries).shape[-1])[:, :width]:
+        candidates = kept
         own = _own_leaf(tree, query) if own_leaf else None
-        kept, strays = [], []  # strays: (index, listed under, lies in)
-        for leaf, lower, upper, _ in walk:
-            indices = tree["order"][tree["start"][leaf] : tree["stop"][leaf]]
-            spared = leaf == own
-            inside = _in_cell(points[indices], lower, upper)
-            kept.extend(indices.tolist() if spared else indices[inside].tolist())
-            if mutual:
-                strays += [(int(i), leaf) for i in indices[~inside]]
-        if mutual:
-            lies_in = {index: _leaf_holding(walk, points[index]) for index, _ in strays}
-            edges = {(listed, lies_in[index]) for index, listed in strays}
-            kept += [index for index, listed in strays if (lies_in[index], listed) in edges]
-        kept = np.array(sorted(kept), dtype=np.int64)
-        s = squared_distances(points[kept], query)
+        if own is not None:  # the query's own leaf unfiltered: its points outside the cell too
+            candidates = np.concatenate([kept, entry_index[(entry_cell == cell_of[own]) & ~inside]])
+        candidates = np.sort(candidates)
+        s = squared_distances(points[candidates], query)
         if k is not None:
-            rank = np.lexsort((kept, s))[:k]
-            rows.append(list(zip(s[rank].tolist(), kept[rank].tolist())))
+            rank = np.lexsort((candidates, s))[:k]
+            rows.append(list(zip(s[rank].tolist(), candidates[rank].tolist())))
         else:
-            inside = s <= radius**2
-            rows.append(list(zip(s[inside].tolist(), kept[inside].tolist())))
+            within = s <= radius**2
+            rows.append(list(zip(s[within].tolist(), candidates[within].tolist())))
     return _knn_rows(rows, k) if k is not None else _csr_rows(rows)
 
 
-def _leaf_holding(walk, point):
-    """The leaf of ``walk`` whose closed cell holds ``point`` (the first), or -1."""
-    return next((leaf for leaf, lower, upper, _ in walk if _in_cell(point[None], lower, upper)[0]), -1)
+def _leaf_cells(tree, width):
+    """Every leaf (in index order) and its closed cell widened by a relative 1e-9: ``(leaves, lower, upper)``,
+    shapes (L,), (L, width), (L, width). A cell does not depend on the query (:func:`lying_trees.leaf_walk`)."""
+    walk = sorted(lying_trees.leaf_walk(tree, np.zeros(width)), key=lambda step: step[0])
+    leaves = [leaf for leaf, _, _, _ in walk]
+    lower = np.array([low for _, low, _, _ in walk], dtype=float).reshape(-1, width)
+    upper = np.array([up for _, _, up, _ in walk], dtype=float).reshape(-1, width)
+    slack = 1e-9 * (1 + np.abs(np.where(np.isfinite(lower), lower, 0)) + np.abs(np.where(np.isfinite(upper), upper, 0)))
+    return leaves, lower - slack, upper + slack
 
 
-def _in_cell(points, lower, upper):
-    """Which points lie in the closed cell, within a relative 1e-9."""
-    slack = 1e-9 * (
-        1 + np.abs(np.nan_to_num(lower, posinf=0, neginf=0)) + np.abs(np.nan_to_num(upper, posinf=0, neginf=0))
-    )
-    return np.all((points >= lower - slack) & (points <= upper + slack), axis=1)
+def _in_cells(points, lower, upper):
+    """Whether each point lies in its (widened) cell: the shapes broadcast, the last axis is the coordinate."""
+    return np.all((points >= lower) & (points <= upper), axis=-1)
 
 
 def _own_leaf(tree, query):

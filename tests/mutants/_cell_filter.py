@@ -151,8 +151,9 @@ def _squared(points, indices, query):
 def _knn(tree, points, queries, k, own_leaf, width, mutual=False):
     points = np.asarray(points, dtype=float)[:, :width]
     rows, dists = [], []
+    shared = _mutual_kept(tree, points) if mutual is True else None  # the same for every query
     for query in np.asarray(queries, dtype=float)[:, :width]:
-        kept = kept_by_cell(tree, points, query, own_leaf, mutual)
+        kept = shared if shared is not None else kept_by_cell(tree, points, query, own_leaf, mutual)
         s = _squared(points, kept, query)
         rank = np.lexsort((kept, s))[:k]
         rows.append(kept[rank])
@@ -163,8 +164,9 @@ def _knn(tree, points, queries, k, own_leaf, width, mutual=False):
 def _radius(tree, points, queries, radius, own_leaf, width, mutual=False):
     points = np.asarray(points, dtype=float)[:, :width]
     rows, dists = [], []
+    shared = _mutual_kept(tree, points) if mutual is True else None  # the same for every query
     for query in np.asarray(queries, dtype=float)[:, :width]:
-        kept = kept_by_cell(tree, points, query, own_leaf, mutual)
+        kept = shared if shared is not None else kept_by_cell(tree, points, query, own_leaf, mutual)
         s = _squared(points, kept, query)
         inside = s <= radius**2
         rank = np.lexsort((kept[inside], s[inside]))
