@@ -323,6 +323,7 @@ def test_farthest_point_sampling_on_a_line(impl):
     # {0, 10}: x=1: 1, x=3: 3, x=7: 3, x=4: 4 -> index 5 (x=4). Then to the
     # nearest of {0, 10, 4}: x=3: 1, x=7: 3, x=1: 1 -> index 3 (x=7).
     result = impl.farthest_point_sampling(points, 4)
+    check_array(result, "indices", shape=(4,), dtype=None)  # before any .tolist()
     assert result.tolist() == [0, 4, 5, 3], (
         f"expected [0, 4, 5, 3], got {result.tolist()}; hint: the next point maximises the distance to "
         "its NEAREST selected point; ties go to the lowest index"
@@ -336,6 +337,7 @@ def test_farthest_point_sampling_uses_the_nearest_selected_point(impl):
     # to point 0; point 3 is farther from both.
     points = np.array([[0.0, 0, 0], [10.0, 0, 0], [0.5, 0, 0], [5.0, 4.0, 0]])
     result = impl.farthest_point_sampling(points, 3)
+    check_array(result, "indices", shape=(3,), dtype=None)  # before any .tolist()
     assert result.tolist() == [0, 1, 3], (
         f"expected [0, 1, 3], got {result.tolist()}: the distance to the NEAREST selected point, not to the last one"
     )
@@ -348,6 +350,7 @@ def test_farthest_point_sampling_uses_euclidean_distance(impl):
     # than (4.5, 0, 0) (4.5).
     points = np.array([[0.0, 0, 0], [3.0, 3.0, 0], [4.5, 0, 0]])
     result = impl.farthest_point_sampling(points, 2)
+    check_array(result, "indices", shape=(2,), dtype=None)  # before any .tolist()
     assert result.tolist() == [0, 2], f"expected [0, 2] (Euclidean distance), got {result.tolist()}"
 
 
@@ -358,6 +361,7 @@ def test_farthest_point_sampling_uses_only_xyz(impl):
     # tie at distance 2 from {0, 5}, and the lower index wins. Counting the column would pick 1 or 4.
     points = np.column_stack([np.arange(6.0), np.zeros(6), np.zeros(6), [0.0, 100, 0, 0, 100, 0]])
     result = impl.farthest_point_sampling(points, 3)
+    check_array(result, "indices", shape=(3,), dtype=None)  # before any .tolist()
     assert result.tolist() == [0, 5, 2], f"extra columns must not count in the distance, got {result.tolist()}"
 
 
@@ -368,6 +372,7 @@ def test_farthest_point_sampling_start_index_and_ties(impl):
     # tie (same distance to their nearest selected corner): lowest index first.
     points = np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0, 1, 0], [0.0, 1, 0]])
     result = impl.farthest_point_sampling(points, 4, start_index=2)
+    check_array(result, "indices", shape=(4,), dtype=None)  # before any .tolist()
     assert result.tolist() == [2, 0, 1, 3], (
         f"expected [2, 0, 1, 3], got {result.tolist()}: start at start_index, ties to the lowest index"
     )
@@ -378,6 +383,7 @@ def test_farthest_point_sampling_start_index_and_ties(impl):
 def test_farthest_point_sampling_never_repeats_with_duplicates(impl):
     points = np.array([[0.0, 0, 0], [0.0, 0, 0], [1.0, 0, 0], [1.0, 0, 0], [0.5, 0, 0]])
     result = impl.farthest_point_sampling(points, 5)
+    check_array(result, "indices", shape=(5,), dtype=None)  # before any .tolist()
     assert sorted(result.tolist()) == [0, 1, 2, 3, 4], f"indices must not repeat, got {result.tolist()}"
     assert result[:3].tolist() == [0, 2, 4], f"expected to start [0, 2, 4], got {result.tolist()}"
 
@@ -484,6 +490,7 @@ def test_normal_space_sampling_draws_round_robin_over_buckets(impl, skewed_norma
     ids = bucket(skewed_normals, 4)
     occupied, sizes = np.unique(ids, return_counts=True)
     result = impl.normal_space_sampling(skewed_normals, 300, n_bins=4, rng=1)
+    check_array(result, "indices", shape=(300,), dtype=None)  # before any .tolist()
     expected, rounds = [], 0
     while len(expected) < 300:  # the bucket sequence is fixed by the contract
         expected += [b for b, s in zip(occupied, sizes) if s > rounds]
@@ -498,6 +505,7 @@ def test_normal_space_sampling_draws_round_robin_over_buckets(impl, skewed_norma
 @pytest.mark.points(2)
 def test_normal_space_sampling_keeps_rare_orientations(impl, skewed_normals):
     result = impl.normal_space_sampling(skewed_normals, 100, rng=2)
+    check_array(result, "indices", shape=(100,), dtype=None)  # before any .tolist()
     up = np.sum(skewed_normals[result, 2] > 0.9)
     assert up <= 40, f"{up} of 100 samples are floor normals: normal space sampling must not sample uniformly"
 
@@ -525,6 +533,7 @@ def test_normal_space_sampling_bucket_boundaries(impl):
     assert ids.tolist() == [14, 14, 12, 22, 4]
     for seed in range(5):
         result = impl.normal_space_sampling(normals, 5, n_bins=3, rng=seed)
+        check_array(result, "indices", shape=(5,), dtype=None)  # before any .tolist()
         assert ids[result].tolist() == [4, 12, 14, 22, 14], (
             f"bucket ids of the draws {ids[result].tolist()}, expected [4, 12, 14, 22, 14]: "
             "b = clip(floor((n + 1) / 2 * n_bins), 0, n_bins - 1), id = b_x + b_y n_bins + b_z n_bins^2"

@@ -42,6 +42,7 @@ def test_radius_outlier_removal_does_not_count_the_point_itself(impl):
         "a duplicate of a point is another point"
     )
     keep = impl.radius_outlier_removal(points, 1.5, 2)
+    check_array(keep, "keep", shape=(len(points),), dtype=None)  # before any .tolist()
     assert keep.tolist() == [False, True, False, False, False, False], (
         f"with min_neighbors=2 only the middle of the chain has 2 OTHER points within 1.5, got {keep.tolist()}"
     )
@@ -122,6 +123,7 @@ def test_statistical_outlier_removal_hand_built(impl):
     points = np.column_stack([x, np.zeros(6), np.zeros(6)])
     # mean 1.5, sample std sqrt(1.5) = 1.2247: threshold at std_ratio 1 is 2.72
     keep = impl.statistical_outlier_removal(points, 1, 1.0)
+    check_array(keep, "keep", shape=(len(points),), dtype=None)  # before any .tolist()
     assert keep.tolist() == [True] * 5 + [False], f"expected only the last point removed, got {keep.tolist()}"
 
 
@@ -134,6 +136,7 @@ def test_statistical_outlier_removal_counts_duplicates_not_itself(impl):
     # k = 1: d = 0, 0, 3, 3, 3, 3, 3 -> mean 15/7, sample std 1.5119;
     # threshold at std_ratio 0.5 = 2.898: the five spaced points are removed.
     keep = impl.statistical_outlier_removal(points, 1, 0.5)
+    check_array(keep, "keep", shape=(len(points),), dtype=None)  # before any .tolist()
     assert keep.tolist() == [True, True, False, False, False, False, False], (
         f"got {keep.tolist()}: a duplicate of point i is a neighbour at distance 0, the point itself is not"
     )
@@ -168,6 +171,7 @@ def test_statistical_outlier_removal_uses_the_sample_standard_deviation(impl):
     d = np.array([1.0, 1.0, 1.0, 1.0, 2.5])
     assert d.mean() + 1.9 * d.std(ddof=0) < 2.5 <= d.mean() + 1.9 * d.std(ddof=1), "test set-up"
     keep = impl.statistical_outlier_removal(points, 1, 1.9)
+    check_array(keep, "keep", shape=(len(points),), dtype=None)  # before any .tolist()
     assert keep.tolist() == [True] * 5, (
         f"got {keep.tolist()}: sigma is the SAMPLE standard deviation (ddof=1): 2.5 <= 1.3 + 1.9 * 0.6708"
     )
