@@ -11,6 +11,7 @@ import itertools
 import os
 import shutil
 import sys
+import traceback
 from pathlib import Path
 
 import numpy as np
@@ -93,30 +94,26 @@ def argument_names(function, paths):
     return sorted(names)
 
 
-def _raised_in(exc, impl):
-    """Whether ``exc`` was raised by a statement of the implementation (or of the course's own package,
-    whose validation helpers it may call), not inside a library."""
-    tb = exc.__traceback__
-    while tb is not None and tb.tb_next is not None:
-        tb = tb.tb_next
-    if tb is None:
-        return False
-    path = Path(tb.tb_frame.f_code.co_filename)
-    roots = [impl.directory, *impl.overrides.values(), REPO_ROOT / "pcl_course"]
+def _origin(exc, impl):
+    """Where ``exc`` was raised, from one walk of its traceback: ``(where, own)``.
+
+    ``where`` is the ``file:line`` of the innermost frame of the
+    implementation (None if none); ``own`` says whether the innermost frame
+    of all is the implementation's or the course package's (whose validation
+    helpers it may call), not a library's.
+    """
+    submission = [impl.directory, *impl.overrides.values()]
+    course = [*submission, REPO_ROOT / "pcl_course"]
+    where, innermost = None, None
+    for frame, line in traceback.walk_tb(exc.__traceback__):
+        innermost = Path(frame.f_code.co_filename)
+        if _under(innermost, submission):
+            where = f"{innermost.name}:{line}"
+    return where, innermost is not None and _under(innermost, course)
+
+
+def _under(path, roots):
     return any(path == root or root in path.parents for root in roots)
-
-
-def _where_in(exc, impl):
-    """file:line of the innermost frame of the implementation in ``exc``'s traceback."""
-    roots = [impl.directory, *impl.overrides.values()]
-    where = None
-    tb = exc.__traceback__
-    while tb is not None:
-        path = Path(tb.tb_frame.f_code.co_filename)
-        if any(path == root or root in path.parents for root in roots):
-            where = f"{path.name}:{tb.tb_lineno}"
-        tb = tb.tb_next
-    return where
 
 
 class Implementation:
@@ -245,9 +242,10 @@ class Implementation:
             except Exception as exc:
                 call.error_type = type(exc).__name__
                 call.error = (str(exc).splitlines() or [""])[0][:200]
-                call.where = getattr(exc, "where", None) or _where_in(exc, self)
+                where, own = _origin(exc, self)
+                call.where = getattr(exc, "where", None) or where
                 if not hasattr(exc, "raised_by_submission"):
-                    exc.raised_by_submission = _raised_in(exc, self)
+                    exc.raised_by_submission = own
                 modified = getattr(exc, "modified", [])
                 raise
             finally:

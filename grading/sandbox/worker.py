@@ -144,22 +144,15 @@ def _shared(arguments, request, exchange, np):
     return arguments
 
 
-def _where(exc):
-    frames = [f for f in traceback.extract_tb(exc.__traceback__) if "pcl_course" in f.filename]
-    if not frames:
-        return ""
-    frame = frames[-1]
-    return f"{os.path.basename(frame.filename)}:{frame.lineno} in {frame.name}"
-
-
 def _failure(exc):
     frames = traceback.extract_tb(exc.__traceback__)
+    own = [f for f in frames if "pcl_course" in f.filename]
     return {
         "ok": False,
         "type": type(exc).__name__,
         "builtin": type(exc).__module__ == "builtins",
         "message": str(exc)[:2000],
-        "where": _where(exc),
+        "where": f"{os.path.basename(own[-1].filename)}:{own[-1].lineno} in {own[-1].name}" if own else "",
         # raised by a statement of the submission's own package (a check of its own), not inside a library
         "own": bool(frames) and "pcl_course" in frames[-1].filename,
     }
