@@ -1,44 +1,12 @@
 """Sends a point on a centre plane to the upper child (x >= cx)."""
 
-import numpy as np
-
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import octree_build as _reference
+from tests.mutants import _plain_trees
 
 MISTAKE = "upper_on_plane"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def octree_build(points, leaf_size=8, min_extent=1e-3):
     _reference(points, leaf_size, min_extent)  # validation only
-    xyz = np.asarray(points, dtype=float)[:, :3]
-    nodes, order = [], []
-
-    def grow(indices, center, extent):
-        node = len(nodes)
-        nodes.append([len(order), 0, center, extent, [-1] * 8])
-        if len(indices) <= leaf_size or extent <= min_extent:
-            order.extend(sorted(indices))
-        else:
-            groups = {}
-            for i in indices:
-                code = sum(1 << j for j in range(3) if xyz[i, j] >= center[j])
-                groups.setdefault(code, []).append(i)
-            for code in sorted(groups):
-                signs = np.array([1.0 if code >> j & 1 else -1.0 for j in range(3)])
-                nodes[node][4][code] = grow(groups[code], center + signs * extent / 2, extent / 2)
-        nodes[node][1] = len(order)
-        return node
-
-    if len(xyz):
-        lower, upper = xyz.min(axis=0), xyz.max(axis=0)
-        grow(list(range(len(xyz))), (lower + upper) / 2, float(np.max((upper - lower) / 2)))
-    else:
-        grow([], np.zeros(3), 0.0)
-    return {
-        "order": np.array(order, dtype=np.int64),
-        "start": np.array([n[0] for n in nodes], dtype=np.int64),
-        "stop": np.array([n[1] for n in nodes], dtype=np.int64),
-        "center": np.array([n[2] for n in nodes], dtype=np.float64).reshape(-1, 3),
-        "extent": np.array([n[3] for n in nodes], dtype=np.float64),
-        "children": np.array([n[4] for n in nodes], dtype=np.int64).reshape(-1, 8),
-    }
+    return _plain_trees.octree_build(points, leaf_size, min_extent, on_plane="upper")
