@@ -22,6 +22,17 @@ def preview(array, n=4):
     return f"{head}{more}"
 
 
+def as_list(value, size):
+    """``value`` as a Python list if it holds ``size`` values, else its :func:`preview`.
+
+    For comparing a small answer with a hand-worked list: a wrong answer may
+    hold millions of values, and a list of them costs the grading tens of
+    bytes a value.
+    """
+    array = np.asarray(value)
+    return array.tolist() if array.size == size else preview(array)
+
+
 def check_array(value, name, shape=None, dtype="float64"):
     """Check that ``value`` is a plain ``np.ndarray`` of ``shape`` and ``dtype``.
 

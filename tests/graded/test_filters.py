@@ -373,6 +373,7 @@ def test_joint_bilateral_upsample_follows_the_guide_edge(impl):
     guide = np.zeros((8, 8, 3))
     guide[:, 4:] = [0.0, 0.8, 0.3]  # the edge is in the 2nd and 3rd channels only
     result = impl.joint_bilateral_upsample(depth, guide, 3.0, 0.1, 3)
+    check_array(result, "dense depth", shape=(8, 8), dtype=None)
     assert np.allclose(result[:, :4], 10.0, atol=1e-3) and np.allclose(result[:, 4:], 20.0, atol=1e-3), (
         "the range weight on the GUIDE (colour distance ||g_p - g_q||^2 over the channels) must keep the "
         f"depth edge where the guide has one; got row 1: {np.round(result[1], 2).tolist()}"

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from grading import instructors_grader
-from grading.checks import check_array, raises
+from grading.checks import as_list, check_array, raises
 from grading.checks.nn import check_bst, check_csr, check_kdtree, check_knn, check_octree
 
 if instructors_grader():  # the instructors' grader (Gradescope, batch): its own trees
@@ -189,6 +189,7 @@ def test_bst_build_hand_worked(impl):
     # 5 is the root; 3 < 5 goes left; 8 right; the second 5 is not < 5: right of the root, then left of 8.
     left, right = impl.bst_build(np.array([5.0, 3.0, 8.0, 5.0]))
     check_array(left, "left", shape=(4,), dtype="int64")
+    check_array(right, "right", shape=(4,), dtype="int64")
     assert left.tolist() == [1, -1, 3, -1] and right.tolist() == [2, -1, -1, -1], (
         f"expected left [1, -1, 3, -1], right [2, -1, -1, -1] (equal keys go right), got {left}, {right}"
     )
@@ -268,6 +269,7 @@ def test_bst_knn_tie_in_the_far_subtree(impl):
     keys = np.array([10.0, 10.0, 9.0])
     left, right = bst_of(impl, keys)
     indices, _ = impl.bst_knn(keys, left, right, 9.5, 2)
+    check_array(indices, "indices", shape=(2,), dtype=None)
     assert indices.tolist() == [0, 1], (
         f"expected [0, 1], got {indices.tolist()}: equal keys go right, so a tie at the k-th distance can lie "
         "on the far side; search it when |keys[j] - query| <= w (inclusive)"
@@ -280,6 +282,7 @@ def test_bst_knn_on_a_path_of_sorted_keys(impl):
     keys = np.arange(1500.0) / 2
     left, right = bst_of(impl, keys)
     indices, distances = impl.bst_knn(keys, left, right, 700.3, 3)
+    check_array(indices, "indices", shape=(3,), dtype=None)
     assert indices.tolist() == [1401, 1400, 1402], "a path of depth 1499: search it with a loop or an explicit stack"
 
 
@@ -316,7 +319,7 @@ def test_kdtree_build_hand_worked(impl):
         "right": [4, 3, -1, -1, -1],
     }
     for key, value in expected.items():
-        got = np.asarray(tree.get(key)).tolist()
+        got = as_list(tree.get(key), len(value))
         assert got == value, f"tree[{key!r}]: expected {value}, got {got}"
     split = np.asarray(tree["split"])
     assert split[:2].tolist() == [3.0, 2.5] and np.all(np.isnan(split[2:])), (
@@ -383,6 +386,7 @@ def test_kdtree_knn_self_far_and_large_coordinate_queries(impl):
     queries = np.vstack([points[:30], points[:10] + [50.0, 0, 0]])
     check_knn(*impl.kdtree_knn(tree, points, queries, 6), *brute_knn(points, queries, 6), "kdtree_knn")
     indices, distances = impl.kdtree_knn(tree, points, points[:5], 1)
+    check_array(indices, "indices", shape=(5, 1), dtype=None)
     assert indices[:, 0].tolist() == list(range(5)) and np.all(distances == 0), "a point is its own nearest"
     points, queries = far_cloud(300, 38)  # the k-th neighbour 1e11 away
     tree = kd_tree(impl, points, 8)
@@ -467,17 +471,17 @@ def test_octree_build_hand_worked(impl):
     # Node 1 (centre 0.5, extent 0.5) splits (0, 0, 0) -> code 0 and (1, 0, 0) -> code 1.
     tree = impl.octree_build(np.array([[0.0, 0, 0], [2.0, 2, 2], [1.0, 0, 0]]), 1)
     assert isinstance(tree, dict), "octree_build returns a dict"
-    assert np.asarray(tree["children"][0]).tolist() == [1, -1, -1, -1, -1, -1, -1, 4], (
+    assert as_list(tree["children"][0], 8) == [1, -1, -1, -1, -1, -1, -1, 4], (
         f"root's children: expected [1, -1, ..., -1, 4], got {tree['children'][0]}"
     )
-    extent = np.asarray(tree["extent"]).tolist()
+    extent = as_list(tree["extent"], 5)
     assert extent == [1.0, 0.5, 0.25, 0.25, 0.5], (
         f"extent (half the side of each node's cube, nodes in preorder): expected [1, 0.5, 0.25, 0.25, 0.5], got "
         f"{extent}: the root's is half the bounding cube's side, each child's half its parent's"
     )
-    order = np.asarray(tree["order"]).tolist()
+    order = as_list(tree["order"], 3)
     assert order == [0, 2, 1], f"order: expected [0, 2, 1] (the leaves' points in preorder), got {order}"
-    center = np.asarray(tree["center"][3]).tolist()
+    center = as_list(tree["center"][3], 3)
     assert center == [0.75, 0.25, 0.25], (
         f"center of node 3 (code 1 under node 1): expected [0.75, 0.25, 0.25], got {center}: a child's centre "
         "is its parent's plus or minus half the parent's extent on each axis, + where its code's bit is 1"
@@ -558,6 +562,7 @@ def test_octree_radius_rejects_bad_input(impl):
     with raises(ValueError, naming="radius"):
         impl.octree_radius(tree, points, points[:2], -1.0)
     indptr, indices, distances = impl.octree_radius(tree, points, np.empty((0, 3)), 0.5)
+    check_array(indptr, "indptr", shape=(1,), dtype=None)
     assert indptr.tolist() == [0] and len(indices) == 0, "no queries: indptr [0] and empty rows"
 
 

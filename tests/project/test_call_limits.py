@@ -9,6 +9,8 @@ few hundred MiB of memory) so that the tests stay fast; they count CPU
 time, not the wall clock, so that a busy machine changes no verdict.
 """
 
+import ast
+import math
 import os
 import subprocess
 import textwrap
@@ -16,7 +18,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from grading import config
+from grading import REPO_ROOT, config
 from grading.errors import SandboxError
 from grading.sandbox import UID, Isolation, Worker, isolation, reserve_uid
 from grading.staging import stage
@@ -262,9 +264,20 @@ LARGE_ANSWERS = textwrap.dedent(
 )
 
 
-def test_what_a_grading_keeps_for_the_diagnosis_is_bounded_as_a_whole(tmp_path, monkeypatch):
+@pytest.fixture
+def large_answers(tmp_path):
+    """A maker of the in-process implementation whose pca answers 800 kB a call (:data:`LARGE_ANSWERS`),
+    made after the test has set its limits (the recorder reads them when it is made)."""
     from grading.implementation import Implementation
 
+    package = tmp_path / "pcl_course"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "pca.py").write_text(LARGE_ANSWERS)
+    return lambda: Implementation(package)
+
+
+def test_what_a_grading_keeps_for_the_diagnosis_is_bounded_as_a_whole(large_answers, monkeypatch):
     def nbytes(value):  # of the arrays a kept copy holds
         if isinstance(value, np.ndarray):
             return value.nbytes
@@ -273,11 +286,7 @@ def test_what_a_grading_keeps_for_the_diagnosis_is_bounded_as_a_whole(tmp_path, 
         return sum(nbytes(v) for v in value.values()) if isinstance(value, dict) else 0
 
     monkeypatch.setattr(config, "DIAGNOSIS_BUDGET", 8 * 2**20, raising=False)
-    package = tmp_path / "pcl_course"
-    package.mkdir()
-    (package / "__init__.py").write_text("")
-    (package / "pca.py").write_text(LARGE_ANSWERS)
-    impl = Implementation(package)
+    impl = large_answers()
     points = np.random.default_rng(0).normal(size=(200, 3))
     for _ in range(40):  # 32 MB of answers in all
         impl.pca(points)
@@ -288,21 +297,15 @@ def test_what_a_grading_keeps_for_the_diagnosis_is_bounded_as_a_whole(tmp_path, 
     assert all(c.result is None and c.args == () for c in calls if not c.kept)
 
 
-def test_answers_held_by_reference_cycles_are_freed_by_bytes_not_object_counts(tmp_path, monkeypatch):
+def test_answers_held_by_reference_cycles_are_freed_by_bytes_not_object_counts(large_answers, monkeypatch):
     """A failed test's traceback holds its frames, and the answers in them, in a reference cycle:
     Python's collector, which counts objects, let such answers pile up (0.86 or 1.4 GiB for one
     grading, by its timing alone). The grading collects once enough answer bytes came in."""
     import gc
     import weakref
 
-    from grading.implementation import Implementation
-
     monkeypatch.setattr(config, "COLLECT_EVERY_BYTES", 4 * 2**20, raising=False)
-    package = tmp_path / "pcl_course"
-    package.mkdir()
-    (package / "__init__.py").write_text("")
-    (package / "pca.py").write_text(LARGE_ANSWERS)
-    impl = Implementation(package)
+    impl = large_answers()
     points = np.random.default_rng(0).normal(size=(200, 3))
     answers = []
     gc.disable()  # only the grading's own collections run
@@ -335,7 +338,6 @@ def test_a_whole_lecture_1_grading_answering_large_arrays_stays_under_1_gib(tmp_
 
     from _helpers import SUBPROCESS_BACKSTOP, load_results
 
-    from grading import REPO_ROOT
 
     clone = tmp_path / "clone"
     shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
@@ -364,6 +366,38 @@ def test_a_whole_lecture_1_grading_answering_large_arrays_stays_under_1_gib(tmp_
     peak_mib = int(peak.read_text().split()[1]) / 1024
     print(f"the grading process peaked at {peak_mib:.0f} MiB")
     assert peak_mib < 1024, f"the grading process peaked at {peak_mib:.0f} MiB"
+
+
+def _unsized_lists(path):
+    """``(test, line, code)`` of every ``.tolist()`` in ``path`` on an answer (a name bound to an ``impl.``
+    call's result) before any ``check_*`` call took that name: a list costs tens of bytes a value."""
+    found = []
+    for test in ast.walk(ast.parse(path.read_text())):
+        if not isinstance(test, ast.FunctionDef) or not test.name.startswith("test"):
+            continue
+        answers, sized = set(), {}
+        for node in ast.walk(test):
+            if isinstance(node, ast.Assign) and isinstance(node.value, ast.Call):
+                if getattr(getattr(node.value.func, "value", None), "id", None) == "impl":
+                    answers |= {n.id for target in node.targets for n in ast.walk(target) if isinstance(n, ast.Name)}
+            if isinstance(node, ast.Call) and getattr(node.func, "id", "").startswith("check_"):
+                for name in (n for argument in node.args for n in ast.walk(argument) if isinstance(n, ast.Name)):
+                    sized[name.id] = min(sized.get(name.id, node.lineno), node.lineno)
+        for node in ast.walk(test):
+            if isinstance(node, ast.Call) and getattr(node.func, "attr", None) == "tolist":
+                names = {n.id for n in ast.walk(node.func.value) if isinstance(n, ast.Name)} & answers
+                if any(sized.get(name, math.inf) >= node.lineno for name in names):
+                    found.append((test.name, node.lineno, ast.unparse(node)[:60]))
+    return found
+
+
+def test_no_graded_test_makes_a_list_of_an_answer_before_checking_its_size():
+    """The large-answer grading above peaked at 645 MiB here and 1137 MiB in CI while tests built lists of
+    two-million-value answers (and f-strings of them); 266 MiB once they checked the shape first."""
+    sources = sorted((REPO_ROOT / "tests" / "graded").glob("test_*.py"))
+    sources += sorted((REPO_ROOT / "tests" / "hidden").glob("test_*.py"))
+    unsized = {path.name: found for path in sources if (found := _unsized_lists(path))}
+    assert not unsized, f"check the shape (check_array) or use grading.checks.as_list first: {unsized}"
 
 
 # -- memory no mapping shows, and memory that outlives its processes ------------------------------
