@@ -338,7 +338,6 @@ def test_a_whole_lecture_1_grading_answering_large_arrays_stays_under_1_gib(tmp_
 
     from _helpers import SUBPROCESS_BACKSTOP, load_results
 
-
     clone = tmp_path / "clone"
     shutil.copytree(REPO_ROOT / "pcl_course", clone / "pcl_course", ignore=shutil.ignore_patterns("__pycache__"))
     functions = config.ASSIGNMENTS["lecture1"]
