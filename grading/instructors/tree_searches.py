@@ -220,9 +220,10 @@ def octree_search(
     return _knn_rows(results, k) if k is not None else _csr_rows(results)
 
 
-def bst_search(keys, left, right, query, k, strict=False, sentinel=None):
-    """The contract's BST search (``strict``: the far side only if ``|key - q| < w``, ``sentinel``: a
-    finite starting worst distance, :func:`_best`; known mistakes)."""
+def bst_search(keys, left, right, query, k, strict=False, sentinel=None, near_twice=False):
+    """The contract's BST search, with the switches of known mistakes: ``strict``, the far side only if
+    ``|key - q| < w``; ``sentinel``, a finite starting worst distance (:func:`_best`); ``near_twice``, for a
+    query left of a node the left child where the far side is (its right subtree is never searched)."""
     best = _best(k, sentinel)
     stack = [(0, False)]
     while stack:
@@ -237,6 +238,8 @@ def bst_search(keys, left, right, query, k, strict=False, sentinel=None):
                 stack.append((near, False))
             continue
         far = right[node] if go_left else left[node]
+        if go_left and near_twice:
+            continue  # the left child again: read already, nothing new
         if far >= 0 and (gap < best.worst or (not strict and gap == best.worst)):
             stack.append((far, False))
     return np.array([i for _, i in best.held], dtype=np.int64), np.array([s for s, _ in best.held], dtype=float)

@@ -10,7 +10,7 @@ import pytest
 from _helpers import load_results
 from _helpers import run_grader as grade
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT
+from grading import GRADED_FUNCTIONS, REPO_ROOT, config
 from grading.diagnosis import ONE_LINE_ALREADY
 from grading.instructors import mistakes
 
@@ -171,7 +171,9 @@ def declared_mistake(path):
     raise AssertionError(f"{path.relative_to(REPO_ROOT)} declares no MISTAKE (its diagnosis, or None)")
 
 
-DIAGNOSIS_FLOOR = 0.9  # of the mutants, named by their diagnosis
+# Of each lecture's mutants, the share named by their diagnosis. Lecture 1 keeps one mutant unnamed
+# (normal_space_sampling/uniform_sampling: a uniform draw cannot be told from a right one draw by draw).
+DIAGNOSIS_FLOOR = {"lecture1": 0.9, "lecture2": 1.0}
 
 
 # Modules whose submissions are graded several at a time: one wrong (or other correct) version of
@@ -327,11 +329,14 @@ def test_wrong_submission_loses_points_and_gets_its_diagnosis(mutants, tmp_path)
         check_wrong_submission(mutant, summary)
 
 
-def test_at_least_nine_in_ten_mutants_are_named_by_their_diagnosis():
-    declared = [path for path in MUTANTS if declared_mistake(path) is not None]
-    rate = len(declared) / len(MUTANTS)
-    print(f"diagnosis promised (and checked, one test each) for {len(declared)} of {len(MUTANTS)} mutants: {rate:.0%}")
-    assert rate >= DIAGNOSIS_FLOOR, f"only {len(declared)} of {len(MUTANTS)} mutants have a diagnosis ({rate:.0%})"
+@pytest.mark.parametrize("assignment", sorted(DIAGNOSIS_FLOOR))
+def test_each_lectures_mutants_are_named_by_their_diagnosis(assignment):
+    mutants = [path for path in MUTANTS if path.parent.name in config.ASSIGNMENTS[assignment]]
+    declared = [path for path in mutants if declared_mistake(path) is not None]
+    rate = len(declared) / len(mutants)
+    print(f"{assignment}: a diagnosis promised (and checked) for {len(declared)} of {len(mutants)} mutants: {rate:.0%}")
+    unnamed = sorted(str(path.relative_to(REPO_ROOT)) for path in set(mutants) - set(declared))
+    assert rate >= DIAGNOSIS_FLOOR[assignment], f"{assignment}: {rate:.0%} named; no diagnosis for {unnamed}"
 
 
 ALTERNATIVE_BATCHES = _batches(ALTERNATIVES)

@@ -249,6 +249,12 @@ BST_KNN = Model(
         ),
         Mistake("filters_by_cell", FILTERS_BY_CELL, bst_interval_filtered),
         Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(bst_knn, squared=False)),
+        Mistake(
+            "near_side_twice",
+            "for a query left of a node (query < keys[j]) the far side is the RIGHT child: your search goes "
+            "to the left child again, so the right subtree of such a node is never searched",
+            lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, near_twice=True),
+        ),
     ),
 )
 

@@ -1,12 +1,12 @@
 """A real student's search (a published homework of the course), in this API: for a query left of a node
 (query < key), the branch that should visit the far side visits the left child again, so the right subtree of
-such a node is never searched. A copy-and-paste slip with no one-line fix to name: the rows show it."""
+such a node is never searched (a copy-and-paste slip)."""
 
 from solutions.nn import *  # noqa: F401,F403
 from solutions.nn import bst_knn as _reference
 from tests.mutants import _plain_trees
 
-MISTAKE = None  # wrong rows, told by the tests themselves
+MISTAKE = "near_side_twice"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
 def bst_knn(keys, left, right, query, k):
