@@ -1,4 +1,4 @@
-"""Lecture 2's whole searches on the grader's trees, with the switches of the mistakes' versions.
+"""Lecture 2's result set and whole searches on the grader's trees, with the switches of the mistakes' versions.
 
 The catalogue of known mistakes (:mod:`grading.instructors.mistakes.nn`)
 predicts what a wrong search answers by running these with a mistake's
@@ -57,6 +57,7 @@ def kdtree_search(
     sentinel=None,
     drop_zero=False,
     misindented=False,
+    strict_descent=False,
 ):
     """The contract's k-d tree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -68,7 +69,9 @@ def kdtree_search(
     ``drop_zero`` (radius: a point only if ``0 < s``, the query's duplicates lost),
     ``misindented`` (kNN: a published homework's if/else, the pruning ``if``
     dedented out of the query-left branch: a query right of a split never
-    reaches the left child; a query left of it reads the right one always).
+    reaches the left child; a query left of it reads the right one always),
+    ``strict_descent`` (the left child first only if ``q[a] < split``: a
+    query on a split plane goes right first).
     """
     points = np.asarray(points, dtype=float)
     queries = _as_rows(queries, points.shape[1])
@@ -106,8 +109,9 @@ def kdtree_search(
                     if diff * diff < best.worst:
                         visit(left)
                 return
+            left_first = diff < 0 if strict_descent else diff <= 0
             near, far = (
-                (tree["left"][node], tree["right"][node]) if diff <= 0 else (tree["right"][node], tree["left"][node])
+                (tree["left"][node], tree["right"][node]) if left_first else (tree["right"][node], tree["left"][node])
             )
             if far_first:
                 near, far = far, near
@@ -139,6 +143,7 @@ def octree_search(
     unclamped=False,
     contained_at_radius=False,
     code_from_x=False,
+    upper_on_plane=False,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -156,7 +161,8 @@ def octree_search(
     clamped at 0: an axis where the query lies within the cube adds to it),
     ``contained_at_radius`` (a contained octant's points reported at distance
     r, not their own), ``code_from_x`` (kNN: the query's own child code
-    computed with x for all three bits, so 0 or 7).
+    computed with x for all three bits, so 0 or 7), ``upper_on_plane`` (kNN:
+    the own code by ``q >= c``, so a query on a centre plane starts in the upper child).
     """
     xyz = np.asarray(points, dtype=float)[:, :3]
     queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
@@ -204,7 +210,9 @@ def octree_search(
             if is_octree_leaf(tree, node):
                 offer(node)
             else:
-                own = sum(1 << j for j in range(3) if query[0 if code_from_x else j] > c[0 if code_from_x else j])
+                axes = [0, 0, 0] if code_from_x else [0, 1, 2]
+                above = query >= c if upper_on_plane else query > c
+                own = sum(1 << j for j, a in enumerate(axes) if above[a])
                 codes = [own] + [i for i in range(8) if i != own] if own_first else list(range(8))
                 for code in codes:
                     child = tree["children"][node, code]
@@ -220,16 +228,46 @@ def octree_search(
     return _knn_rows(results, k) if k is not None else _csr_rows(results)
 
 
-def bst_search(keys, left, right, query, k, strict=False, sentinel=None, near_twice=False):
+def result_set(distances, indices, k, ties="lower", pad=False, sentinel=math.inf):
+    """The contract's result set; ``ties="later"``: an equal distance evicts the worst (a known mistake)."""
+    distances = np.array(distances, dtype=float)
+    indices = np.array(indices)
+    if distances.ndim != 1 or indices.shape != distances.shape or not np.all(np.isfinite(distances)):
+        raise ValueError("candidates")
+    if np.any(distances < 0) or len(set(indices.tolist())) != len(indices) or not isinstance(k, (int, np.integer)):
+        raise ValueError("candidates")
+    if k < 1:
+        raise ValueError("k")
+    held, worst = [], []
+    for d, i in zip(distances.tolist(), indices.tolist()):
+        if len(held) < k:
+            held.append((d, i))
+        elif (d, i) < held[-1] if ties == "lower" else d <= held[-1][0]:
+            held[-1] = (d, i)
+        if ties == "lower":
+            held.sort()
+        else:
+            held.sort(key=lambda pair: pair[0])  # distance only: ties stay in the order they came
+        worst.append(held[-1][0] if len(held) == k else sentinel)
+    out_i = np.array([i for _, i in held], dtype=np.int64)
+    out_d = np.array([d for d, _ in held], dtype=float)
+    if pad and len(held) < k:
+        out_i = np.concatenate([out_i, np.full(k - len(held), -1, dtype=np.int64)])
+        out_d = np.concatenate([out_d, np.full(k - len(held), np.inf)])
+    return out_i, out_d, np.array(worst, dtype=float)
+
+
+def bst_search(keys, left, right, query, k, strict=False, sentinel=None, near_twice=False, equal_left=False):
     """The contract's BST search, with the switches of known mistakes: ``strict``, the far side only if
     ``|key - q| < w``; ``sentinel``, a finite starting worst distance (:func:`_best`); ``near_twice``, for a
-    query left of a node the left child where the far side is (its right subtree is never searched)."""
+    query left of a node the left child where the far side is (its right subtree is never searched);
+    ``equal_left``, a query equal to a node's key goes left first (``query <= key``)."""
     best = _best(k, sentinel)
     stack = [(0, False)]
     while stack:
         node, near_done = stack.pop()
         gap = abs(keys[node] - query)
-        go_left = query < keys[node]
+        go_left = query <= keys[node] if equal_left else query < keys[node]
         if not near_done:
             best.offer(gap, node)
             stack.append((node, True))

@@ -82,13 +82,16 @@ def failure(what, answer, planted, planted_failure, expected=(), trapped=()):
     return wrong_answer_failure(what)
 
 
-def fair_queries(points, seed, reach, count=N_QUERIES):
-    """Random queries in the cloud's box whose rule decisions are clear of ties."""
+def fair_queries(points, seed, reach, count=N_QUERIES, onto=None):
+    """Random queries in the cloud's box whose rule decisions are clear of ties; with ``onto``, each moved
+    onto a plane (``onto(query, rng)``), where only the contract's descent rule says which side is first."""
     rng = np.random.default_rng(seed)
     lower, upper = points.min(axis=0), points.max(axis=0)
     chosen = []
     while len(chosen) < count:
         query = rng.uniform(lower, upper)
+        if onto is not None:
+            query = onto(query, rng)
         reached, margin = reach(query)
         if margin > MARGIN:
             chosen.append((query, reached))
@@ -130,12 +133,15 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
     keys = rng.uniform(0, 1000, 2000)
     left, right = trees.bst(keys)
     traps = 0
-    for k, count in ((1, 4), (5, 4), (12, 12)):
+    for k, count, on_keys in ((1, 4, False), (5, 4, False), (12, 12, False), (5, 6, True)):
         for query in rng.uniform(100, 900, count):
+            if on_keys:  # a query equal to a key of its path: the contract goes right first (equal keys go right)
+                query = keys[rng.choice(bst_path(keys, left, right, query))]
             reached, margin = trees.bst_reach(keys, left, right, query, k)
             if margin < MARGIN:
                 continue
-            nearest = np.sort(np.abs(keys - query))[0]
+            gaps = np.abs(keys - query)
+            nearest = np.min(gaps[gaps > 0])  # the decoys lie nearer than any other key, the query's own apart
             trapped_keys, trapped = lying_trees.bst_trap_swaps(keys, left, right, query, k)
             traps += len(trapped) // 2
             lying = trapped_keys.copy()
@@ -146,6 +152,15 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
             if as_list(indices, k) != expected.tolist():
                 raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"), expected, trapped)
     assert traps >= 2, "the test needs traps on its queries"
+
+
+def bst_path(keys, left, right, query):
+    """The nodes the descent passes from the root (left when ``query < key``)."""
+    path, node = [], 0
+    while node >= 0:
+        path.append(node)
+        node = left[node] if query < keys[node] else right[node]
+    return path
 
 
 # -- k-d tree -------------------------------------------------------------------------------------
@@ -167,11 +182,31 @@ def test_kdtree_build_hidden_exact_on_new_clouds(impl):
             assert np.array_equal(tree[key], expected[key], equal_nan=True), f"kdtree_build: {key} differs"
 
 
-def kd_decoy_case(points, leaf_size, seed, k=None, radius=None):
-    """Per fair query: the lying tree (traps swapped in), the lying cloud (decoys moved), decoys and traps."""
+def onto_a_split_plane(tree):
+    """Moves a query onto the split plane of a random node of its descent path: the contract sends it to
+    the left child first (``q[a] <= split``), a strict ``<`` to the right one."""
+
+    def move(query, rng):
+        path, node = [], 0
+        while tree["axis"][node] >= 0:
+            path.append(node)
+            node = tree["left"][node] if query[tree["axis"][node]] <= tree["split"][node] else tree["right"][node]
+        node = path[rng.integers(len(path))]
+        query = query.copy()
+        query[tree["axis"][node]] = tree["split"][node]
+        return query
+
+    return move
+
+
+def kd_decoy_case(points, leaf_size, seed, k=None, radius=None, on_planes=False):
+    """Per fair query: the lying tree (traps swapped in), the lying cloud (decoys moved), decoys and traps;
+    ``on_planes``: the queries lie on split planes (:func:`onto_a_split_plane`)."""
     tree = trees.kdtree(points, leaf_size)
     rng = np.random.default_rng(seed)
-    for query, reached in fair_queries(points, seed, lambda q: trees.kdtree_reach(tree, points, q, k=k, radius=radius)):
+    onto = onto_a_split_plane(tree) if on_planes else None
+    reach = lambda q: trees.kdtree_reach(tree, points, q, k=k, radius=radius)  # noqa: E731
+    for query, reached in fair_queries(points, seed, reach, onto=onto):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
         lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
@@ -203,8 +238,8 @@ class Traps:
 def test_kdtree_knn_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 83)
     planted = []
-    for k in (1, 8):
-        for tree, query, lying, decoys, traps in kd_decoy_case(points, 8, 84 + k, k=k):
+    for k, on_planes in ((1, False), (8, False), (8, True)):
+        for tree, query, lying, decoys, traps in kd_decoy_case(points, 8, 84 + k + on_planes, k=k, on_planes=on_planes):
             planted.append(traps)
             indices, distances = impl.kdtree_knn(tree, lying, query[None], k)
             expected = trees.brute_knn(points, query, k)
@@ -265,7 +300,24 @@ def test_octree_build_hidden_exact_on_new_clouds(impl):
             assert np.array_equal(tree[key], expected[key]), f"octree_build: {key} differs"
 
 
-def oc_decoy_case(points, leaf_size, seed, k=None, radius=None):
+def onto_a_centre_plane(tree):
+    """Moves a query onto a centre plane of a random inner node of its descent path: the contract's own
+    child code (``q > c``) puts it in the lower child there, ``q >= c`` in the upper one."""
+
+    def move(query, rng):
+        path, node = [], 0
+        while node >= 0 and not trees.is_octree_leaf(tree, node):
+            path.append(node)
+            node = tree["children"][node, int(sum(1 << j for j in range(3) if query[j] > tree["center"][node][j]))]
+        node, axis = path[rng.integers(len(path))], rng.integers(3)
+        query = query.copy()
+        query[axis] = tree["center"][node][axis]
+        return query
+
+    return move
+
+
+def oc_decoy_case(points, leaf_size, seed, k=None, radius=None, on_planes=False):
     tree = trees.octree(points, leaf_size, 1e-3)
     rng = np.random.default_rng(seed)
 
@@ -273,7 +325,8 @@ def oc_decoy_case(points, leaf_size, seed, k=None, radius=None):
         reached, _, _, margin = trees.octree_reach(tree, points, query, k=k, radius=radius)
         return reached, margin
 
-    for query, reached in fair_queries(points, seed, reach):
+    onto = onto_a_centre_plane(tree) if on_planes else None
+    for query, reached in fair_queries(points, seed, reach, onto=onto):
         nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
         lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
@@ -353,8 +406,8 @@ def test_octree_radius_hidden_reports_a_contained_octant_whole(impl):
 def test_octree_knn_hidden_reads_only_what_its_rule_reaches(impl):
     points = uniform(4096, 94)
     planted = []
-    for k in (1, 6):
-        for tree, query, lying, decoys, traps in oc_decoy_case(points, 8, 95 + k, k=k):
+    for k, on_planes in ((1, False), (6, False), (6, True)):
+        for tree, query, lying, decoys, traps in oc_decoy_case(points, 8, 95 + k + on_planes, k=k, on_planes=on_planes):
             planted.append(traps)
             indices, distances = impl.octree_knn(tree, lying, query[None], k)
             expected = trees.brute_knn(points, query, k)

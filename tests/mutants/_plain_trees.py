@@ -13,10 +13,11 @@ import numpy as np
 __all__ = ["bst_knn", "kdtree_build", "kdtree_knn", "kdtree_radius", "octree_build", "octree_knn", "octree_radius"]
 
 
-def bst_knn(keys, left, right, query, k, prune="<=", far_when_left="right", sentinel=None):
+def bst_knn(keys, left, right, query, k, prune="<=", far_when_left="right", sentinel=None, left_if="<"):
     """k nearest keys by a plain explicit-stack search; ``prune`` is "<=" or "<", and ``far_when_left``
     is the child searched as the far side of a query left of a node ("left": the copy-and-paste slip).
-    ``sentinel``: the result set starts as k slots (sentinel, 0), the homework's finite "worst distance"."""
+    ``sentinel``: the result set starts as k slots (sentinel, 0), the homework's finite "worst distance".
+    ``left_if`` "<=": a query equal to a node's key goes left first (equal keys were inserted right)."""
     keys = np.asarray(keys, dtype=float)
     held = _slots(k, sentinel)  # (gap, index), sorted
 
@@ -27,7 +28,7 @@ def bst_knn(keys, left, right, query, k, prune="<=", far_when_left="right", sent
     while stack:
         node, near_done = stack.pop()
         gap = abs(keys[node] - query)
-        go_left = query < keys[node]
+        go_left = query <= keys[node] if left_if == "<=" else query < keys[node]
         if not near_done:
             held = sorted([*held, (gap, node)])[:k]
             stack.append((node, True))
@@ -135,7 +136,7 @@ def _slots(k, sentinel):
     return [] if sentinel is None else [(sentinel, 0)] * k
 
 
-def _kd_search(tree, points, query, k, radius, far_first, prune, keep, sentinel=None):
+def _kd_search(tree, points, query, k, radius, far_first, prune, keep, sentinel=None, descend="<="):
     held = _slots(k, sentinel)  # (squared distance, index), sorted
 
     def bound():
@@ -155,7 +156,8 @@ def _kd_search(tree, points, query, k, radius, far_first, prune, keep, sentinel=
             return
         diff = query[tree["axis"][node]] - tree["split"][node]
         near, far = tree["left"][node], tree["right"][node]
-        if (diff > 0) != far_first:  # the query's side first; with far_first, the other side
+        right_first = diff > 0 if descend == "<=" else diff >= 0  # descend "<": a query on the plane goes right
+        if right_first != far_first:  # the query's side first; with far_first, the other side
             near, far = far, near
         visit(near)
         gap = abs(diff) if prune == "|d| <= w2" else diff * diff
@@ -166,12 +168,14 @@ def _kd_search(tree, points, query, k, radius, far_first, prune, keep, sentinel=
     return sorted(held)
 
 
-def kdtree_knn(tree, points, queries, k, far_first=False, prune="<=", sentinel=None):
+def kdtree_knn(tree, points, queries, k, far_first=False, prune="<=", sentinel=None, descend="<="):
     """kNN rows of a plain depth-first search; ``prune`` is "<=", "<", "none" or "|d| <= w2";
-    ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`)."""
+    ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`); ``descend`` "<":
+    the left child first only if ``q[a] < split`` (a query on a split plane goes right first)."""
     points = np.asarray(points, dtype=float)
     rows = [
-        _kd_search(tree, points, q, k, None, far_first, prune, "<=", sentinel) for q in np.asarray(queries, dtype=float)
+        _kd_search(tree, points, q, k, None, far_first, prune, "<=", sentinel, descend)
+        for q in np.asarray(queries, dtype=float)
     ]
     return _knn_arrays(rows, k)
 
@@ -201,6 +205,7 @@ def _octree_search(
     unclamped=False,
     contained_at_radius=False,
     code_from_x=False,
+    upper_on_plane=False,
 ):
     held = _slots(k, sentinel) if k is not None else []  # (squared distance, index), sorted
 
@@ -239,7 +244,8 @@ def _octree_search(
             offer(node)
         else:
             axes = [0, 0, 0] if code_from_x else [0, 1, 2]  # the copy-and-paste slip: x for every bit
-            own = int(sum(1 << j for j, a in enumerate(axes) if query[a] > center[a]))
+            above = query >= center if upper_on_plane else query > center  # ">=": a plane's query goes up
+            own = int(sum(1 << j for j, a in enumerate(axes) if above[a]))
             codes = [own] + [c for c in range(8) if c != own] if own_first else list(range(8))
             for code in codes:
                 if children[code] >= 0 and meets(children[code]) and visit(children[code]):
@@ -262,11 +268,13 @@ def octree_knn(
     sentinel=None,
     unclamped=False,
     code_from_x=False,
+    upper_on_plane=False,
 ):
     """kNN rows of a plain recursive octree search (Behley's order and early termination by default);
-    ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`)."""
+    ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`); ``upper_on_plane``:
+    the query's own child code by ``q >= c`` (a query on a centre plane starts in the upper child)."""
     xyz = np.asarray(points, dtype=float)[:, :3]
-    flags = (True, early, own_first, box, strict, False, sentinel, False, unclamped, False, code_from_x)
+    flags = (True, early, own_first, box, strict, False, sentinel, False, unclamped, False, code_from_x, upper_on_plane)
     rows = [_octree_search(tree, xyz, q[:3], k, None, *flags) for q in np.asarray(queries, dtype=float)]
     return _knn_arrays(rows, k)
 

@@ -47,9 +47,7 @@ SENTINELS = (1e5, 1e8, 1e9, 1e10)
 
 def _finite_sentinel(search, squared):
     """The searches with each known finite sentinel: Variants, one per value."""
-    return lambda **arguments: Variants(
-        search(**arguments, sentinel=value**2 if squared else value) for value in SENTINELS
-    )
+    return lambda **arguments: Variants(search(**arguments, sentinel=v**2 if squared else v) for v in SENTINELS)
 
 
 KEEPS_SWAPS = (
@@ -89,55 +87,26 @@ def _radius_of(radius):
 # -- knn_result_set -------------------------------------------------------------------------------
 
 
-def result_set(distances, indices, k, ties="lower", pad=False, sentinel=math.inf):
-    """The contract's result set; ``ties="later"``: an equal distance evicts the worst (a known mistake)."""
-    distances = np.array(distances, dtype=float)
-    indices = np.array(indices)
-    if distances.ndim != 1 or indices.shape != distances.shape or not np.all(np.isfinite(distances)):
-        raise ValueError("candidates")
-    if np.any(distances < 0) or len(set(indices.tolist())) != len(indices) or not isinstance(k, (int, np.integer)):
-        raise ValueError("candidates")
-    if k < 1:
-        raise ValueError("k")
-    held, worst = [], []
-    for d, i in zip(distances.tolist(), indices.tolist()):
-        if len(held) < k:
-            held.append((d, i))
-        elif (d, i) < held[-1] if ties == "lower" else d <= held[-1][0]:
-            held[-1] = (d, i)
-        if ties == "lower":
-            held.sort()
-        else:
-            held.sort(key=lambda pair: pair[0])  # distance only: ties stay in the order they came
-        worst.append(held[-1][0] if len(held) == k else sentinel)
-    out_i = np.array([i for _, i in held], dtype=np.int64)
-    out_d = np.array([d for d, _ in held], dtype=float)
-    if pad and len(held) < k:
-        out_i = np.concatenate([out_i, np.full(k - len(held), -1, dtype=np.int64)])
-        out_d = np.concatenate([out_d, np.full(k - len(held), np.inf)])
-    return out_i, out_d, np.array(worst, dtype=float)
-
-
 KNN_RESULT_SET = Model(
-    truth=result_set,
+    truth=tree_searches.result_set,
     output_dtypes=("int64", "float64", "float64"),
     mistakes=(
         Mistake(
             "ties_to_the_later",
             "an equal distance must not evict the worst held candidate unless its index is lower: order by "
             "(distance, index), so that ties go to the lower index",
-            lambda distances, indices, k: result_set(distances, indices, k, ties="later"),
+            lambda distances, indices, k: tree_searches.result_set(distances, indices, k, ties="later"),
         ),
         Mistake(
             "padded",
             "return min(k, n) candidates, never padded with -1 or inf when fewer than k were offered",
-            lambda distances, indices, k: result_set(distances, indices, k, pad=True),
+            lambda distances, indices, k: tree_searches.result_set(distances, indices, k, pad=True),
         ),
         Mistake(
             "finite_sentinel",
             "the worst distance is inf while fewer than k are held, not a large finite number: any finite "
             "sentinel is beaten by a real distance somewhere",
-            lambda distances, indices, k: result_set(distances, indices, k, sentinel=1e10),
+            lambda distances, indices, k: tree_searches.result_set(distances, indices, k, sentinel=1e10),
         ),
     ),
 )
@@ -254,6 +223,12 @@ BST_KNN = Model(
             "for a query left of a node (query < keys[j]) the far side is the RIGHT child: your search goes "
             "to the left child again, so the right subtree of such a node is never searched",
             lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, near_twice=True),
+        ),
+        Mistake(
+            "equal_goes_left",
+            "a query equal to a node's key goes RIGHT first (query < keys[j] goes left), as equal keys do: "
+            "yours goes left, and reads nodes in another order than the rule",
+            lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, equal_left=True),
         ),
     ),
 )
@@ -374,6 +349,12 @@ KDTREE_KNN = Model(
             lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, misindented=True),
         ),
         Mistake("keeps_swaps", KEEPS_SWAPS, _cell_filters(_kd_case, mutual=True)),
+        Mistake(
+            "strict_descent",
+            "a query on a split plane (q[axis] == split) goes to the LEFT child first (q[axis] <= split): "
+            "yours goes right, and reads nodes in another order than the rule",
+            lambda tree, points, queries, k: kdtree_knn(tree, points, queries, k, strict_descent=True),
+        ),
     ),
 )
 
@@ -566,6 +547,12 @@ OCTREE_KNN = Model(
             "the query's own child code takes one bit per axis: (q_x > c_x) + 2 (q_y > c_y) + 4 (q_z > c_z); with x "
             "for every bit the search starts in the wrong octant and reads octants its rule never reaches",
             lambda tree, points, queries, k: octree_knn(tree, points, queries, k, code_from_x=True),
+        ),
+        Mistake(
+            "upper_on_plane",
+            "the query's own child has bit j set when q[j] > center[j], as in the build: with >=, a query on a "
+            "centre plane starts in the other child, and reads nodes in another order than the rule",
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, upper_on_plane=True),
         ),
     ),
 )
