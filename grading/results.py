@@ -31,6 +31,7 @@ import unicodedata
 from dataclasses import dataclass, field
 
 from grading.config import GRADED_FUNCTIONS, MAX_OUTPUT, MAX_OUTPUT_LINES, MAX_TEXT
+from grading.hidden import hidden_points
 
 NOT_RUN = "not run: grading stopped before this test"
 HIDDEN_NOTE = "(hidden test: details withheld)"
@@ -245,6 +246,12 @@ class Grading:
 
     # -- the terminal ---------------------------------------------------------------------
 
+    def _hidden_later(self, per_function):
+        """Function -> hidden points still to come, for a run without hidden tests (a student's own)."""
+        if any(test.hidden for test in self.tests):
+            return {}
+        return {function: points for function, points in hidden_points().items() if function in per_function}
+
     def to_table(self, title):
         """The marks as a plain-text table: every test, hidden ones included (instructors' view)."""
         lines = [clean(title, newlines=False), ""]
@@ -258,10 +265,19 @@ class Grading:
         lines += ["", f"Total: {self.score:g} / {self.max_score:g}"]
         diagnoses = self.all_diagnoses or self.diagnoses
         per_function = self.per_function()
+        later = self._hidden_later(per_function)
         if per_function:
             lines += ["", "Per function:"]
             for function, (score, maximum) in per_function.items():
                 found = diagnoses.get(function)
-                lines.append(f"  {function}: {score:g} / {maximum:g}" + (f" - {found['message']}" if found else ""))
+                hidden = f" (+ {later[function]:g} in hidden tests)" if function in later else ""
+                told = f" - {found['message']}" if found else ""
+                lines.append(f"  {function}: {score:g} / {maximum:g}{hidden}{told}")
+        if later:
+            lines += [
+                "",
+                f"Hidden tests carry {sum(later.values()):g} more points of these functions: the instructors' "
+                "grader runs them after the deadline, on other data (the book's exercises say what they check).",
+            ]
         lines += [line for line in (self.note, self.isolation) if line]  # where the reader's eye ends
         return "\n".join(lines)

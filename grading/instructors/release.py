@@ -19,7 +19,8 @@ from pathlib import Path
 
 import yaml
 
-from grading import REPO_ROOT
+from grading import HIDDEN_TESTS, REPO_ROOT
+from grading.hidden import POINTS_FILE, write_points_file
 from grading.instructors.leakcheck import find_leaks
 from grading.instructors.shipping import IGNORED, WITHHELD, cut_reference_link, substitute
 
@@ -332,6 +333,7 @@ def release(out_dir, course_repository=None, course_ref=None):
         else:
             shutil.copy2(source, out / name)
     shutil.rmtree(out / WITHHELD)  # the instructors' tools: all of them, and only them
+    write_points_file(HIDDEN_TESTS, out / POINTS_FILE.relative_to(REPO_ROOT))  # what the local table announces
     for page in (out / "book").glob("*.md"):
         page.write_text(_strip_solutions(page.read_text()))
     cut_reference_link(out / "pcl_course")

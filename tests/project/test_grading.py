@@ -579,3 +579,15 @@ def test_a_hidden_structure_test_tells_a_decoy_read_from_points_lost(tmp_path):
 
     assert "octree_radius reads nodes its rule does not reach" in line(read)
     assert "octree_radius answers wrong on the nodes its rule reaches" in line(lost)
+
+
+def test_the_hidden_points_a_local_run_announces_are_the_hidden_tests_points(reference_grading):
+    # A student's run has no hidden tests; its table adds what they carry (grading/hidden.py).
+    from grading.hidden import hidden_points
+
+    summary, _ = reference_grading
+    graded = {}
+    for test in summary["tests"]:
+        if test["visibility"] != "visible":
+            graded[test["tags"][0]] = graded.get(test["tags"][0], 0.0) + test["max_score"]
+    assert hidden_points() == graded

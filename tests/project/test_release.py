@@ -3,6 +3,7 @@ not, that its grader gives the stubs 0 points without an error, and that
 the reference's code is caught if it slips in."""
 
 import hashlib
+import json
 import os
 import re
 import shutil
@@ -14,6 +15,7 @@ import yaml
 from _helpers import STEP_BACKSTOP, SUBPROCESS_BACKSTOP, load_results
 
 from grading import EXERCISE_MODULES, REPO_ROOT
+from grading.hidden import hidden_points
 from grading.instructors.leakcheck import find_leaks
 from grading.instructors.shipping import WITHHELD
 
@@ -362,6 +364,11 @@ def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
     assert summary["score"] == 0 and summary["max_score"] > 0
     odd = [t for t in summary["tests"] if not t["text"].startswith("not implemented")]
     assert not odd, [(t["name"], t["text"]) for t in odd[:3]]
+    # No hidden test ships, but the table says what they carry, from the points the release wrote down.
+    hidden = hidden_points()
+    assert json.loads((release_dir / "grading" / "hidden_points.json").read_text()) == hidden
+    assert f"kdtree_knn: 0 / 10 (+ {hidden['kdtree_knn']:g} in hidden tests)" in completed.stdout
+    assert f"Hidden tests carry {sum(hidden.values()):g} more points of these functions" in completed.stdout
 
 
 def test_the_release_book_builds_with_the_stubs(release_dir):
