@@ -18,6 +18,7 @@ import pytest
 from grading import instructors_grader
 from grading.checks import as_list, check_array, raises
 from grading.checks.nn import check_bst, check_csr, check_kdtree, check_knn, check_octree
+from grading.errors import CheckFailed
 
 if instructors_grader():  # the instructors' grader (Gradescope, batch): its own trees
     from grading.instructors import trees as grader_trees
@@ -87,6 +88,37 @@ def brute_radius(points, queries, radius):
         order = inside[np.lexsort((inside, s[inside]))]
         rows.append((order, np.sqrt(s[order])))
     return rows
+
+
+def two_clusters(n, seed, dim=3):
+    """``n`` points in the cube [-1, 1]^dim, then ``n`` more 100 away along the first axis: for a query
+    well inside the first cluster, the contract's rule never reads the second (its cells lie some 50 away)."""
+    return np.vstack([cube(n, seed, dim), cube(n, seed + 1, dim) + np.eye(dim)[0] * 100.0])
+
+
+def with_decoys(points, far, query):
+    """The cloud as a lying tree shows it: the points ``far`` moved next to the query, nearer than any other,
+    while the tree still lists them where they were. A search that follows the rule never reads them; one
+    that reads every point (brute force, a library, no pruning) returns them. The hidden structure tests
+    plant such decoys in every node the rule does not reach, on other data."""
+    lying = np.array(points, dtype=float)
+    others = np.setdiff1d(np.arange(len(lying)), far)
+    nearest = np.sqrt(np.min(squared(lying[others].reshape(len(others), -1), np.atleast_1d(query))))
+    offsets = nearest * 1e-3 * (1.0 + np.arange(len(far)) / len(far))
+    lying[far] = np.atleast_1d(query) + (offsets[:, None] if lying.ndim == 2 else offsets)
+    return lying
+
+
+def check_no_decoy(indices, far, what):
+    """Fail, naming the rule, if a search returned a planted decoy (:func:`with_decoys`)."""
+    read = np.intersect1d(np.asarray(indices).ravel(), far)
+    if len(read):
+        raise CheckFailed(
+            f"{what} returned point {read[0]} of the far cluster, which its rule never reaches for this query; "
+            "its coordinates were moved next to the query, and a search that follows the rule never reads "
+            "them: yours reads points its rule does not reach (brute force, a library, no pruning)",
+            rule=f"{what} reads nodes its rule does not reach",
+        )
 
 
 # -- the trees searched -------------------------------------------------------------------------
@@ -288,6 +320,22 @@ def test_bst_knn_on_a_path_of_sorted_keys(impl):
 
 @pytest.mark.grades("bst_knn")
 @pytest.mark.points(1)
+def test_bst_knn_never_reads_a_subtree_its_rule_skips(impl):
+    # The second cluster's keys, all above the first's, hang below the first's largest key: for a query in
+    # [-0.8, 0], |that key - query| is far above w, so the rule never goes there.
+    keys = two_clusters(300, 13, dim=1)[:, 0]
+    left, right = bst_of(impl, keys)
+    far = np.arange(300, 600)
+    for query, k in ((-0.8, 1), (-0.35, 4), (0.0, 9)):
+        indices, distances = impl.bst_knn(with_decoys(keys, far, query), left, right, query, k)
+        check_array(indices, "indices", shape=(k,), dtype="int64")
+        check_no_decoy(indices, far, "bst_knn")
+        expected = np.lexsort((np.arange(300), np.abs(keys[:300] - query)))[:k]
+        check_knn(indices[None], distances[None], expected[None], np.abs(keys[expected] - query)[None], "bst_knn")
+
+
+@pytest.mark.grades("bst_knn")
+@pytest.mark.points(1)
 @pytest.mark.interface
 def test_bst_knn_rejects_bad_input(impl):
     keys = np.array([5.0, 3.0, 8.0])
@@ -391,6 +439,19 @@ def test_kdtree_knn_self_far_and_large_coordinate_queries(impl):
     points, queries = far_cloud(300, 38)  # the k-th neighbour 1e11 away
     tree = kd_tree(impl, points, 8)
     check_knn(*impl.kdtree_knn(tree, points, queries, 20), *brute_knn(points, queries, 20), "kdtree_knn, far queries")
+
+
+@pytest.mark.grades("kdtree_knn")
+@pytest.mark.points(1)
+def test_kdtree_knn_never_reads_a_cluster_its_rule_skips(impl):
+    points = two_clusters(300, 39)  # the root splits them, some 50 from either
+    tree = kd_tree(impl, points, 8)
+    far = np.arange(300, 600)
+    for query in cube(4, 40) * 0.7:
+        indices, distances = impl.kdtree_knn(tree, with_decoys(points, far, query), query[None], 6)
+        check_array(indices, "indices", shape=(1, 6), dtype="int64")
+        check_no_decoy(indices, far, "kdtree_knn")
+        check_knn(indices, distances, *brute_knn(points[:300], query[None], 6), "kdtree_knn")
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -587,6 +648,19 @@ def test_octree_knn_on_a_grid_with_exact_ties(impl):
         queries = np.vstack([points[::9], points[::19] + 0.5])
         for k in (1, 7, 19):
             check_knn(*impl.octree_knn(tree, points, queries, k), *brute_knn(points, queries, k), f"octree_knn, k={k}")
+
+
+@pytest.mark.grades("octree_knn")
+@pytest.mark.points(1)
+def test_octree_knn_never_reads_a_cluster_its_rule_skips(impl):
+    points = two_clusters(300, 79)  # the root's x-plane splits them, some 50 from either
+    tree = oc_tree(impl, points, 8)
+    far = np.arange(300, 600)
+    for query in cube(4, 80) * 0.7:
+        indices, distances = impl.octree_knn(tree, with_decoys(points, far, query), query[None], 6)
+        check_array(indices, "indices", shape=(1, 6), dtype="int64")
+        check_no_decoy(indices, far, "octree_knn")
+        check_knn(indices, distances, *brute_knn(points[:300], query[None], 6), "octree_knn")
 
 
 @pytest.mark.grades("octree_knn")
