@@ -434,25 +434,25 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
         and s[i] > bound2 * (1 + TRAP_MARGIN)
     ]
     candidates.sort(key=lambda i: (-s[i], i))  # the farthest first: room for a place in U nearer than it
-    gaps = {leaf: _box_gap_squared(lower, upper, query) for leaf, (lower, upper, _) in boxes.items()}
+    decoys = np.asarray(decoys, dtype=np.int64)
+    placed = result[decoys, :width]
+    clear = np.min(np.minimum(placed - y_lower, y_upper - placed), axis=1) > clearance * DECOY_FRACTION
+    clear = [int(d) for d in decoys[clear]]  # the decoys that lie clearly in Y
+    gaps = {listed[d]: _box_gap_squared(*boxes[listed[d]][:2], query) for d in clear}
     partnered, counters = [], []
-    for d in sorted((int(d) for d in decoys), key=lambda d: (gaps[listed[d]], d)):  # the nearest leaves first
+    for d in sorted(clear, key=lambda d: (gaps[listed[d]], d)):  # the nearest leaves first
         if len(counters) == pairs or not candidates:
             break
-        if _depth_inside(result[d, :width], y_lower, y_upper) <= clearance * DECOY_FRACTION:
-            continue  # the decoy does not lie clearly in Y
         u = listed[d]
         u_lower, u_upper, _ = boxes[u]
         members = tree["order"][tree["start"][u] : tree["stop"][u]]
-        places = [xyz[d]] + [(xyz[d] + xyz[v]) / 2 for v in members if v != d]
-        places = [
-            x
-            for x in places
-            if _depth_inside(x, u_lower, u_upper) > clearance
-            and float(squared_distances(x[None], query)[0]) > bound2 * (1 + TRAP_MARGIN)
-        ]
-        for x in sorted(places, key=lambda x: float(squared_distances(x[None], query)[0])):
-            sx = float(squared_distances(x[None], query)[0])
+        # The places: d's own, then halfway to each other point of U; those deep in U's cell and beyond the bound.
+        places = np.vstack([xyz[d][None], (xyz[d] + xyz[members[members != d]]) / 2])
+        depth = np.min(np.minimum(places - u_lower, u_upper - places), axis=1)
+        sp = squared_distances(places, query)
+        fit = np.flatnonzero((depth > clearance) & (sp > bound2 * (1 + TRAP_MARGIN)))
+        for j in fit[np.argsort(sp[fit], kind="stable")]:  # the nearest place first
+            x, sx = places[j], float(sp[j])
             fits = [c for c in candidates if k is None or s[c] > sx * (1 + TRAP_MARGIN)]
             if fits:
                 c = fits[0]
