@@ -161,9 +161,11 @@ def bst_knn(keys, left, right, query, k):
     keys : array_like, shape (N,)
         Finite keys.
     left, right : array_like of int, shape (N,)
-        A tree on the N nodes rooted at node 0, as :func:`bst_build` returns.
+        A tree on the N nodes rooted at node 0, as :func:`bst_build` returns:
+        every other node is the child of exactly one node with a smaller id
+        (the nodes are numbered in insertion order).
     query : float
-        The query key, finite.
+        The query key, finite: a Python or NumPy scalar, or a 0-d array.
     k : int
         Number of neighbours, ``1 <= k <= N``.
 
@@ -177,8 +179,8 @@ def bst_knn(keys, left, right, query, k):
     Raises
     ------
     ValueError
-        Bad ``keys`` or ``query``; ``left``/``right`` that are not one tree
-        on N nodes rooted at 0; ``k`` outside ``1..N``.
+        Bad ``keys`` or ``query``; ``left``/``right`` that are not such a
+        tree; ``k`` outside ``1..N``.
 
     Examples
     --------

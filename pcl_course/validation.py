@@ -104,6 +104,10 @@ def as_points(points, name="points", min_columns=3, columns=None, allow_empty=Tr
 
 
 def _is_real_number(value):
+    """A real number: a Python or NumPy scalar, or a 0-d array of integers or floats (what NumPy's reductions
+    and indexing give); never a ``bool``."""
+    if isinstance(value, np.ndarray):
+        return value.ndim == 0 and value.dtype.kind in "iuf"
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
@@ -115,7 +119,8 @@ def check_scalar(value, name, low=None, high=None, include_low=True, include_hig
     Parameters
     ----------
     value : object
-        The argument to check (a ``bool`` is refused).
+        The argument to check: a Python or NumPy real scalar, or a 0-d array of
+        one (a ``bool`` is refused).
     name : str
         The argument's name, for the error message.
     low, high : float, optional

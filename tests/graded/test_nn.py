@@ -337,7 +337,7 @@ def test_bst_knn_never_reads_a_subtree_its_rule_skips(impl):
 @pytest.mark.grades("bst_knn")
 @pytest.mark.points(1)
 @pytest.mark.interface
-def test_bst_knn_rejects_bad_input(impl):
+def test_bst_knn_checks_its_input(impl):
     keys = np.array([5.0, 3.0, 8.0])
     left, right = np.array([1, -1, -1]), np.array([2, -1, -1])
     with raises(ValueError, naming="k"):
@@ -346,6 +346,10 @@ def test_bst_knn_rejects_bad_input(impl):
         impl.bst_knn(keys, np.array([1, 1, -1]), right, 4.0, 1)  # node 1 is its own child
     with raises(ValueError):
         impl.bst_knn(keys, left, right, np.nan, 1)
+    for query in (np.float64(4.0), np.array(4.0)):  # a NumPy scalar and a 0-d array are queries too
+        indices, _ = impl.bst_knn(keys, left, right, query, 2)
+        check_array(indices, "indices", shape=(2,), dtype=None)
+        assert indices.tolist() == [0, 1], f"query {query!r}: expected [0, 1], got {indices.tolist()}"
 
 
 # -- kdtree_build -------------------------------------------------------------------------------

@@ -13,7 +13,7 @@ import numpy as np
 
 from grading.instructors import tree_searches, trees
 from grading.instructors.mistakes import Mistake, Model, Raised, Variants, valid_points
-from pcl_course.validation import check_bst, check_kdtree, check_octree
+from pcl_course.validation import check_bst, check_kdtree, check_octree, check_radius, check_scalar
 
 READS_UNREACHED = (
     "your search reads points of nodes its rule never reaches (the hidden structure tests plant decoys there): "
@@ -79,9 +79,7 @@ def _k_of(k, n):
 
 
 def _radius_of(radius):
-    if not isinstance(radius, (int, float, np.floating, np.integer)) or not math.isfinite(radius) or radius < 0:
-        raise ValueError("radius")
-    return float(radius)
+    return check_radius(radius)
 
 
 # -- knn_result_set -------------------------------------------------------------------------------
@@ -167,9 +165,7 @@ BST_BUILD = Model(
 def _bst_case(keys, left, right, query, k):
     keys = _keys(keys)
     left, right = check_bst(left, right, len(keys))  # a loop in the links would never end
-    if not isinstance(query, (int, float, np.floating, np.integer)) or not math.isfinite(query):
-        raise ValueError("query")
-    return keys, left, right, float(query), _k_of(k, len(keys))
+    return keys, left, right, check_scalar(query, "query"), _k_of(k, len(keys))
 
 
 def bst_knn(keys, left, right, query, k, **changes):
