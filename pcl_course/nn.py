@@ -380,12 +380,18 @@ def octree_radius(tree, points, queries, radius):
     Per query, depth first from the root, at an octant of cube (c, e):
 
     1. If the ball contains the cube, ``sum_j (|q_j - c_j| + e) ** 2 <=
-       radius ** 2``, every point of the octant is kept, without descending.
+       radius ** 2``, every point of the octant is kept, without descending
+       and without a distance test (the cube test decides: a point whose
+       rounded squared distance exceeds ``radius ** 2`` by an ulp is kept).
     2. Else, at a leaf, each of its points is kept if its squared distance
        is ``<= radius ** 2``.
     3. Else, the children whose cube meets the ball,
        ``sum_j max(|q_j - c_j| - e, 0) ** 2 <= radius ** 2``, are visited in
        code order.
+
+    The search does not end early, as :func:`octree_knn` does: it needs no
+    such step, since when the ball lies strictly inside an octant no other
+    octant meets it, and step 3 skips them all.
 
     Parameters
     ----------
@@ -394,7 +400,8 @@ def octree_radius(tree, points, queries, radius):
     points : array_like, shape (N, D), D >= 3
         The cloud the tree was built on.
     queries : array_like, shape (M, D)
-        Query points (their xyz is used).
+        Query points, as wide as ``points`` (a cloud's own rows are queries);
+        their xyz is used.
     radius : float
         Search radius, finite and >= 0 (inclusive).
 
@@ -422,8 +429,10 @@ def octree_knn(tree, points, queries, k):
     points are offered in their order in the tree (as
     :func:`knn_result_set`). At an internal octant, the child whose code the
     query has (if it exists) is visited first, then the other children in
-    code order, each if and only if its cube meets the ball,
-    ``sum_j max(|q_j - c_j| - e, 0) ** 2 <= w2`` at that moment. **Early
+    code order, each of them, the first included, if and only if its cube
+    meets the ball, ``sum_j max(|q_j - c_j| - e, 0) ** 2 <= w2`` at that
+    moment (the first always does when the query lies in the octant; an
+    octant entered as another's neighbour need not hold it). **Early
     termination:** after an octant has been processed, if the ball lies
     strictly inside its cube, ``|q_j - c_j| + w < e`` for every j, the
     query's search ends.
@@ -435,7 +444,8 @@ def octree_knn(tree, points, queries, k):
     points : array_like, shape (N, D), D >= 3
         The cloud the tree was built on.
     queries : array_like, shape (M, D)
-        Query points (their xyz is used).
+        Query points, as wide as ``points`` (a cloud's own rows are queries);
+        their xyz is used.
     k : int
         Number of neighbours, ``1 <= k <= N``.
 

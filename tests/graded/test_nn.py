@@ -626,6 +626,9 @@ def test_octree_radius_rejects_bad_input(impl):
     tree = oc_tree(impl, points, 4)
     with raises(ValueError, naming="radius"):
         impl.octree_radius(tree, points, points[:2], -1.0)
+    wide = np.hstack([points, np.ones((30, 1))])  # xyz and one more column
+    with raises(ValueError, naming="queries"):  # the queries are as wide as the points, though xyz is used
+        impl.octree_radius(oc_tree(impl, wide, 4), wide, points[:2], 0.5)
     indptr, indices, distances = impl.octree_radius(tree, points, np.empty((0, 3)), 0.5)
     check_array(indptr, "indptr", shape=(1,), dtype=None)
     assert indptr.tolist() == [0] and len(indices) == 0, "no queries: indptr [0] and empty rows"
