@@ -444,6 +444,8 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
         if len(counters) == pairs or not candidates:
             break
         u = listed[d]
+        if k is not None and gaps[u] >= s[candidates[0]]:
+            break  # every place in U, and in the farther leaves after it, lies beyond every candidate
         u_lower, u_upper, _ = boxes[u]
         members = tree["order"][tree["start"][u] : tree["stop"][u]]
         # The places: d's own, then halfway to each other point of U; those deep in U's cell and beyond the bound.
