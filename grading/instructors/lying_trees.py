@@ -415,7 +415,10 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
     clearance = SWAP_CLEARANCE * math.sqrt(bound2)
     walk = leaf_walk(tree, query)
     boxes = {leaf: (lower, upper, path) for leaf, lower, upper, path in walk}
-    own = [leaf for leaf, lower, upper, _ in walk if _depth_inside(query, lower, upper) > clearance]
+    lowers = np.array([lower for _, lower, _, _ in walk]).reshape(len(walk), width)
+    uppers = np.array([upper for _, _, upper, _ in walk]).reshape(len(walk), width)
+    depths = np.min(np.minimum(query - lowers, uppers - query), axis=1)  # _depth_inside, every leaf at once
+    own = [leaf for (leaf, _, _, _), depth in zip(walk, depths) if depth > clearance]
     if len(own) != 1:
         return result, np.empty(0, np.int64), np.empty(0, np.int64)
     y = own[0]
@@ -438,7 +441,9 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
     placed = result[decoys, :width]
     clear = np.min(np.minimum(placed - y_lower, y_upper - placed), axis=1) > clearance * DECOY_FRACTION
     clear = [int(d) for d in decoys[clear]]  # the decoys that lie clearly in Y
-    gaps = {listed[d]: _box_gap_squared(*boxes[listed[d]][:2], query) for d in clear}
+    # _box_gap_squared, every leaf at once
+    gaps = np.sum((np.maximum(lowers - query, 0.0) + np.maximum(query - uppers, 0.0)) ** 2, axis=1)
+    gaps = dict(zip((leaf for leaf, _, _, _ in walk), gaps.tolist()))
     partnered, counters = [], []
     for d in sorted(clear, key=lambda d: (gaps[listed[d]], d)):  # the nearest leaves first
         if len(counters) == pairs or not candidates:
