@@ -29,6 +29,7 @@ import ast
 import copy
 import inspect
 import os
+import re
 import sys
 from dataclasses import dataclass, field
 
@@ -201,9 +202,15 @@ def _points(call, function):
 
 
 def _not_a_validation_error(call):
-    """An exception of the code's own (unpacking three values, broadcasting), not a ValueError it meant."""
+    """An exception of the code's own (unpacking three values, broadcasting), not a ValueError it meant.
+
+    A message that starts by naming an argument (``queries must have shape
+    (N, 4), ...``, as pcl_course.validation's do) is a check, whatever it says
+    next; NumPy's own messages never start so."""
     if call.error_type != "ValueError":
         return True
+    if re.match(r"[A-Za-z_]\w* must\b", call.error or ""):
+        return False
     return any(word in (call.error or "") for word in ("unpack", "broadcast", "shape", "could not"))
 
 

@@ -208,6 +208,11 @@ def test_extra_columns_names_a_crash_on_wide_clouds_only():
     [
         # The student's own check of the width (a ValueError meant as one): no crash.
         [answered("t1", cloud(4), np.zeros(3)), raised("t2", cloud(4, 5), "ValueError", "points must be (N, 3)")],
+        # A check of another argument on a wide cloud (a bad-input test's call), naming a shape.
+        [
+            answered("t1", cloud(4), np.zeros(3)),
+            raised("t2", cloud(4, 5), "ValueError", "queries must have shape (N, 5), got (2, 3)"),
+        ],
         # Narrow clouds crash too: not the columns.
         [raised("t1", cloud(4), "IndexError"), raised("t2", cloud(4, 5), "IndexError")],
         # One wide cloud answered.
@@ -219,7 +224,7 @@ def test_extra_columns_names_a_crash_on_wide_clouds_only():
         # No narrow cloud to compare with.
         [raised("t2", cloud(4, 5), "IndexError")],
     ],
-    ids=["own check", "narrow crash", "one wide answered", "no narrow"],
+    ids=["own check", "a check naming a shape", "narrow crash", "one wide answered", "no narrow"],
 )
 def test_extra_columns_is_silent_unless_only_every_wide_cloud_crashes(calls):
     """A ValueError of the student's own check, crashes on narrow clouds too, a wide cloud answered,
