@@ -146,10 +146,14 @@ def _explicit(function, calls, outcomes, failed, context):
         why = errors.pop() if errors else "the submission was refused"
         return Diagnosis("sandbox", f"every test failed the same way: {why}", failed)
     if kinds == {FORBIDDEN}:
+        module = GRADED_FUNCTIONS[function]
+        extra = config.FORBIDDEN_IN_MODULE.get(module, ())  # a module with rules of its own: no "and SciPy"
+        how = "NumPy and SciPy"
+        if extra:
+            how = f"NumPy ({extra[0]} and {len(extra) - 1} more are forbidden in {module}.py)"
         return Diagnosis(
             "forbidden_api",
-            f"{GRADED_FUNCTIONS[function]}.py uses a forbidden package (see the tests' message): "
-            "write your own code with NumPy and SciPy",
+            f"{module}.py uses a forbidden package (see the tests' message): write your own code with {how}",
             failed,
         )
     return None

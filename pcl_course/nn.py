@@ -32,8 +32,8 @@ Trees
     :func:`pcl_course.validation.check_kdtree` or ``check_octree`` (structure
     only). A search works on any valid tree, not only its own module's, and
     **reads the points of a node only if the stated rule reaches that node**.
-    It may prune more than the rule (a tighter test on a node's cell,
-    best-bin-first order), never less: the grader checks this with trees
+    It may prune more than the rule (a tighter test on a node's cell; for
+    the k-d tree, best-bin-first order), never less: the grader checks this with trees
     whose unreached nodes hold decoys (the book proves why every correct
     search passes). Do not check that the points lie in their nodes' cells.
 

@@ -63,10 +63,11 @@ def wrong_answer_failure(what):
 
 
 def dropped_failure(what):
+    point, cell = ("key", "interval") if what.startswith("bst") else ("point", "cell")  # a BST holds keys
     return CheckFailed(
-        f"{what}: your search dropped a point of a node it must read (it checks whether points lie in their "
-        "node's cell): the contract says to trust the tree",
-        rule=f"{what} drops points of nodes it must read (it checks them against their cells)",
+        f"{what}: your search dropped a {point} of a node it must read (it checks whether {point}s lie in their "
+        f"node's {cell}): the contract says to trust the tree",
+        rule=f"{what} drops {point}s of nodes it must read (it checks them against their {cell}s)",
     )
 
 
@@ -452,7 +453,8 @@ def test_octree_knn_hidden_ends_when_the_ball_is_inside_an_octant(impl):
             late = CheckFailed(
                 "octree_knn: once an octant has been processed and the ball of the k-th distance lies strictly "
                 "inside its cube, the search must end (early termination), and the query's own child comes first",
-                rule="octree_knn does not end early, or visits children in another order",
+                rule="octree_knn reads an octant after the one where it must end (it does not end early, visits "
+                "children in another order, or reads every point)",
             )
             raise failure("octree_knn", indices, [decoy], late) from None
         used += 1

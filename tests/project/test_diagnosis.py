@@ -123,7 +123,14 @@ def test_explicit_names_a_forbidden_api_in_its_module():
     """Every failed test is the forbidden scan's: the line names the function's module."""
     found = run(_explicit, [], failed("t1", "t2", kind=FORBIDDEN))
     assert found.id == "forbidden_api" and "pca.py uses a forbidden package" in found.message
-    assert found.explains == ("t1", "t2")
+    assert found.explains == ("t1", "t2") and found.message.endswith("with NumPy and SciPy")
+
+
+def test_a_forbidden_api_in_nn_is_not_told_to_use_scipy():
+    # nn.py's own rules forbid scipy.spatial: "write your own code with NumPy and SciPy" sent students back to it.
+    found = run(_explicit, [], failed("t1", kind=FORBIDDEN), function="kdtree_knn")
+    assert found.id == "forbidden_api" and "and SciPy" not in found.message
+    assert "scipy.spatial and 9 more are forbidden in nn.py" in found.message
 
 
 def test_explicit_names_a_refused_submission_with_its_one_error():

@@ -26,6 +26,8 @@ FILTERS_BY_CELL = (
     "the contract says to trust the tree; read only what the rule reaches, and keep every point you read"
 )
 
+FILTERS_BY_INTERVAL = FILTERS_BY_CELL.replace("point", "key").replace("cell", "interval")  # a BST holds keys
+
 DROPS_ZERO = (
     "keep every point with squared distance <= r ** 2, 0 included: the query itself and its duplicates "
     "are neighbours (a test 0 < s, or skipping the query's own index, drops them)"
@@ -212,7 +214,7 @@ BST_KNN = Model(
             "k-th distance with a lower index is missed",
             lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, strict=True),
         ),
-        Mistake("filters_by_cell", FILTERS_BY_CELL, bst_interval_filtered),
+        Mistake("filters_by_cell", FILTERS_BY_INTERVAL, bst_interval_filtered),
         Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(bst_knn, squared=False)),
         Mistake(
             "near_side_twice",
