@@ -204,7 +204,13 @@ def check_same_shape(array, name, shape, what, leading=False):
 
 
 def check_integer(value, name, low=None, high=None):
-    """Return ``value`` as an int after checking ``low <= value <= high``."""
+    """Return ``value`` as an int after checking ``low <= value <= high``.
+
+    ``value`` is a Python or NumPy integer, or a 0-d array of one (as
+    :func:`check_scalar` takes a 0-d array of a real); never a ``bool``.
+    """
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iu":
+        value = value.item()
     if not isinstance(value, numbers.Integral) or isinstance(value, bool):
         raise ValueError(f"{name} must be an integer, got {value!r}")
     value = int(value)

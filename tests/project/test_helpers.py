@@ -42,7 +42,8 @@ def test_check_positive_rejects(value):
 
 def test_check_integer_and_choice_and_rng():
     assert validation.check_integer(np.int64(3), "k", 1, 5) == 3
-    for bad in (0, 6, 2.5, True):
+    assert validation.check_integer(np.array(3), "k", 1, 5) == 3  # a 0-d array, as NumPy gives
+    for bad in (0, 6, 2.5, True, np.array(True), np.array(2.0), np.array([3])):
         with pytest.raises(ValueError, match="k"):
             validation.check_integer(bad, "k", 1, 5)
     with pytest.raises(ValueError, match="method"):
@@ -90,6 +91,7 @@ def test_check_scalar_accepts_finite_numbers_within_bounds():
     from pcl_course.validation import check_scalar
 
     assert check_scalar(2, "x") == 2.0 and type(check_scalar(2, "x")) is float
+    assert check_scalar(np.array(0.5), "x") == 0.5 and type(check_scalar(np.array(0.5), "x")) is float  # 0-d
     assert check_scalar(0.0, "x", low=0) == 0.0 and check_scalar(1.0, "x", high=1.0) == 1.0
     for value, kwargs in (
         (0.0, {"low": 0, "include_low": False}),
@@ -99,6 +101,9 @@ def test_check_scalar_accepts_finite_numbers_within_bounds():
         (float("inf"), {}),
         (True, {}),
         ("1", {}),
+        (np.array(True), {}),
+        (np.array([1.0]), {}),
+        (np.array(1 + 2j), {}),
     ):
         with pytest.raises(ValueError, match="^x must be a finite number"):
             check_scalar(value, "x", **kwargs)

@@ -13,7 +13,7 @@ import numpy as np
 
 from grading.instructors import tree_searches, trees
 from grading.instructors.mistakes import Mistake, Model, Raised, Variants, valid_points
-from pcl_course.validation import check_bst, check_kdtree, check_octree, check_radius, check_scalar
+from pcl_course.validation import check_bst, check_integer, check_kdtree, check_octree, check_radius, check_scalar
 
 READS_UNREACHED = (
     "your search reads points of nodes its rule never reaches (the hidden structure tests plant decoys there): "
@@ -75,9 +75,7 @@ def _cell_filters(case, mutual=False):
 
 
 def _k_of(k, n):
-    if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or not 1 <= k <= n:
-        raise ValueError("k")
-    return int(k)
+    return check_integer(k, "k", low=1, high=n)
 
 
 def _radius_of(radius):
