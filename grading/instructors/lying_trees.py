@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from grading.instructors.trees import DECOY_FRACTION, is_octree_leaf, squared_distances
+from grading.instructors.trees import DECOY_FRACTION, squared_distances
 
 __all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps", "counter_decoys"]
 
@@ -47,17 +47,18 @@ def decoy_points(points, tree, reached, query, nearest, rng, radius=None):
         The moved points' indices.
     """
     leaves = _leaves(tree)
-    covered = set()
+    covered = np.zeros(len(tree["order"]), dtype=bool)
     for node in reached:
-        covered.update(range(tree["start"][node], tree["stop"][node]))
+        covered[tree["start"][node] : tree["stop"][node]] = True
+    free = np.flatnonzero(~covered)  # the positions in ``order`` no reached node lists
     moved = np.array(points, dtype=float)
     decoys = []
     scale = DECOY_FRACTION * min(nearest, radius if radius else math.inf)
     for leaf in leaves:
-        positions = [p for p in range(tree["start"][leaf], tree["stop"][leaf]) if p not in covered]
-        if not positions:
+        first = np.searchsorted(free, tree["start"][leaf])  # the leaf's first free position, if any
+        if first == len(free) or free[first] >= tree["stop"][leaf]:
             continue
-        index = int(tree["order"][positions[0]])
+        index = int(tree["order"][free[first]])
         direction = rng.standard_normal(moved.shape[1])
         direction /= np.linalg.norm(direction)
         moved[index] = query + direction * scale * (1 + len(decoys) / (2 * len(leaves)))
@@ -118,19 +119,20 @@ def leaf_walk(tree, query, within=None):
             stack += [right, left] if query[a] <= s else [left, right]  # the near child is popped first
         return walk
     query = query[:3]
+    children = np.asarray(tree["children"]).tolist()  # plain lists: a node at a time, NumPy costs more than it saves
     stack = [(0, [0])]
     while stack:
         node, path = stack.pop()
         center, extent = tree["center"][node], tree["extent"][node]
         if within is not None and _box_gap_squared(center - extent, center + extent, query) > within:
             continue
-        if is_octree_leaf(tree, node):
+        if max(children[node]) < 0:  # a leaf (is_octree_leaf)
             walk.append((node, center - extent, center + extent, path))
             continue
         own = sum(1 << j for j in range(3) if query[j] > center[j])
         codes = [own] + [c for c in range(8) if c != own]
         for code in reversed(codes):
-            child = int(tree["children"][node, code])
+            child = children[node][code]
             if child >= 0:
                 stack.append((child, path + [child]))
     return walk
