@@ -33,9 +33,10 @@ Trees
     only). A search works on any valid tree, not only its own module's, and
     **reads the points of a node only if the stated rule reaches that node**.
     It may prune more than the rule (a tighter test on a node's cell; for
-    the k-d tree, best-bin-first order), never less: the grader checks this with trees
-    whose unreached nodes hold decoys (the book proves why every correct
-    search passes). Do not check that the points lie in their nodes' cells.
+    the k-d tree, best-bin-first order), never less: the grader checks this
+    with trees whose unreached nodes hold decoys (the book proves why every
+    search this contract allows passes). Do not check that the points lie in
+    their nodes' cells.
 
 Forbidden here
     ``scipy.spatial``, scikit-learn, Open3D, pykdtree, pynanoflann, faiss,
