@@ -14,9 +14,9 @@ import math
 
 import numpy as np
 
-from grading.instructors.trees import DECOY_FRACTION, squared_distances
+from grading.instructors.trees import DECOY_FRACTION, bst_reach, squared_distances
 
-__all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps", "counter_decoys"]
+__all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps", "counter_decoys", "bst_own_swap"]
 
 
 # -- lying trees ----------------------------------------------------------------------------------
@@ -351,6 +351,110 @@ def bst_trap_swaps(keys, left, right, query, k, pairs=2):
             swapped += [a, b]
             break
     return lying, np.array(swapped, dtype=np.int64)
+
+
+def bst_descent(keys, left, right, value):
+    """The nodes a descent for ``value`` passes from the root (left when ``value < key``), the last included."""
+    path, node = [], 0
+    while node >= 0:
+        path.append(int(node))
+        node = left[node] if value < keys[node] else right[node]
+    return path
+
+
+def _bst_intervals(keys, left, right):
+    """Each node's interval ``(lo, hi)`` from its ancestors' keys (``[lo, key)`` to the left, ``[key, hi]`` right)."""
+    lo, hi = np.full(len(keys), -math.inf), np.full(len(keys), math.inf)
+    stack = [0]
+    while stack:
+        node = stack.pop()
+        for child, a, b in ((left[node], lo[node], keys[node]), (right[node], keys[node], hi[node])):
+            if child >= 0:
+                lo[child], hi[child] = a, b
+                stack.append(int(child))
+    return lo, hi
+
+
+TRIES = 20  # partners tried, the nearest first
+
+
+def bst_own_swap(keys, left, right, query, k, partner="unreached", margin=TRAP_MARGIN):
+    """``keys`` with the key of C, the node where the query's descent ends, swapped with a childless node's.
+
+    Every key a BST search reads steers it, but for those of childless
+    nodes: those can move without changing where a search goes. C's
+    interval holds the query, so the structure test's decoys (every key the
+    rule never reaches, moved next to the query) lie in it, and a swap
+    through C is what makes a misplacement mutual:
+
+    - ``partner="unreached"``, a counter-decoy (the BST's form of
+      :func:`counter_decoys`): U is a childless node the rule never reaches.
+      C takes U's key, beyond the k-th distance, and the decoy the test
+      plants at U lies in C's interval: the two are swapped both ways, so a
+      search that keeps the keys swapped both ways keeps that decoy and
+      returns it. The test must leave U's ancestors their keys (no decoys
+      there), so that U's interval, and the descent that ends at U, are the
+      true tree's.
+    - ``partner="reached"``, a trap through C, which :func:`bst_trap_swaps`
+      makes only when a childless node's key is nearer the query than C's
+      (rarely: C's key is one of the query's two neighbours among the keys).
+      U is a childless node the rule reads whose key lies beyond the k-th
+      distance; C's key, in the answer, moves to U. A search that keeps the
+      keys swapped both ways but those through C drops it.
+
+    The reach is worked out again on the new keys: U must stay unreached (or
+    reached), with no far-side test within ``margin`` of a tie, and a trap's
+    moved key must stay in the answer.
+
+    Parameters
+    ----------
+    keys : ndarray, shape (N,)
+    left, right : ndarray of int, shape (N,)
+        The BST of ``keys``.
+    query : float
+    k : int
+    partner : {"unreached", "reached"}
+    margin : float, default TRAP_MARGIN
+        The least relative gap between a far-side test and the k-th distance
+        on the new keys (as :func:`grading.instructors.trees.bst_reach`).
+
+    Returns
+    -------
+    lying : ndarray, shape (N,)
+        ``keys`` with U's key at C, and C's at U if U is reached (a copy; ``keys`` itself if there is no
+        pair). An unreached U keeps its key: the decoy planted there is its partner.
+    pair : tuple of int or None
+        ``(C, U)``, or None when C has children or no U qualifies.
+    """
+    keys = np.asarray(keys, dtype=float)
+    c = bst_descent(keys, left, right, query)[-1]
+    childless = (np.asarray(left) < 0) & (np.asarray(right) < 0)
+    if not childless[c]:
+        return keys, None
+    reached, _ = bst_reach(keys, left, right, query, k)
+    lo, hi = _bst_intervals(keys, left, right)
+    gaps = np.abs(keys - query)
+    bound = float(np.sort(gaps)[k - 1])
+    clearance = SWAP_CLEARANCE * max(bound, np.finfo(float).tiny)
+    inside = (keys - lo > clearance) & (hi - keys > clearance)
+    is_reached = np.zeros(len(keys), dtype=bool)
+    is_reached[sorted(reached)] = True
+    want_reached = partner == "reached"
+    fit = childless & inside & (is_reached == want_reached) & (gaps > bound * (1 + TRAP_MARGIN))
+    fit[c] = False
+    candidates = np.flatnonzero(fit)
+    for u in candidates[np.argsort(gaps[candidates], kind="stable")][:TRIES]:
+        lying = keys.copy()
+        lying[c] = keys[u]
+        if want_reached:
+            lying[u] = keys[c]
+        now_reached, now_margin = bst_reach(lying, left, right, query, k)
+        if (u in now_reached) != want_reached or now_margin <= margin:
+            continue
+        if want_reached and u not in np.lexsort((np.arange(len(keys)), np.abs(lying - query)))[:k]:
+            continue
+        return lying, (int(c), int(u))
+    return keys, None
 
 
 # -- counter-decoys: a partner for a decoy, so that a decoy's misplacement is mutual too ----------

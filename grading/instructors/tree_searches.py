@@ -283,6 +283,40 @@ def bst_search(keys, left, right, query, k, strict=False, sentinel=None, near_tw
     return np.array([i for _, i in best.held], dtype=np.int64), np.array([s for s, _ in best.held], dtype=float)
 
 
+def _bst_descent_end(keys, left, right, value):
+    node = 0
+    while True:
+        child = left[node] if value < keys[node] else right[node]
+        if child < 0:
+            return node
+        node = child
+
+
+def bst_filtered_search(keys, left, right, query, k, nested=True, mutual=False):
+    """A known cheat: every node read, its key dropped if outside the node's interval, the k nearest of the rest.
+
+    A node's interval comes from its ancestors' keys (below a key to the
+    left, at or above it to the right); ``nested`` clips a child's interval
+    to its parent's, else the parent's key is taken as is (the two differ
+    under a node whose key lies outside its own interval). ``mutual=True``
+    keeps, of the keys outside their intervals, those swapped both ways (the
+    descent of each ends at the other's node), as the traps are
+    (:func:`lying_trees.bst_own_swap` gives a decoy such a partner).
+    """
+    kept, strays, stack = [], [], [(0, -math.inf, math.inf)]
+    while stack:
+        node, lo, hi = stack.pop()
+        (kept if lo <= keys[node] <= hi else strays).append(node)
+        below, above = (min(hi, keys[node]), max(lo, keys[node])) if nested else (keys[node], keys[node])
+        stack += [(int(c), a, b) for c, a, b in ((left[node], lo, below), (right[node], above, hi)) if c >= 0]
+    if mutual:
+        lies_in = {n: _bst_descent_end(keys, left, right, keys[n]) for n in strays}
+        kept += [n for n in strays if lies_in.get(lies_in[n]) == n]
+    kept = np.array(sorted(kept), dtype=np.int64)
+    rank = np.lexsort((kept, np.abs(keys[kept] - query)))[:k]
+    return kept[rank], np.abs(keys[kept[rank]] - query)
+
+
 def cell_filtered_search(tree, points, queries, k=None, radius=None, own_leaf=False, mutual=False):
     """A known cheat: every leaf read, its points outside the leaf's (closed) cell dropped, brute force on the rest.
 

@@ -309,7 +309,11 @@ class Best:
 
 
 def bst_reach(keys, left, right, query, k):
-    """The nodes the contract's BST search reads for one query, and its closest call (as :func:`kdtree_reach`)."""
+    """The nodes the contract's BST search reads for one query, and its closest call (as :func:`kdtree_reach`).
+
+    A far-side test at a node whose own key is the k-th held is no close call:
+    the gap is the k-th distance itself, the same number however a search works
+    it out, so the inclusive rule goes to the far side."""
     best = Best(k)
     reached, margin = set(), math.inf
     stack = [(0, False)]
@@ -327,7 +331,9 @@ def bst_reach(keys, left, right, query, k):
             continue
         far = right[node] if go_left else left[node]
         if far >= 0:
-            if math.isfinite(best.worst) and best.worst > 0:
+            # A node whose own key is the k-th is tied with itself, exactly, however a search computes the gap.
+            itself = len(best.held) == k and best.held[-1][1] == node
+            if math.isfinite(best.worst) and best.worst > 0 and not itself:
                 margin = min(margin, abs(gap - best.worst) / best.worst)
             if gap <= best.worst:
                 stack.append((far, False))

@@ -25,7 +25,10 @@ Some decoys get a partner (:func:`grading.instructors.lying_trees.counter_decoys
 a far point of the query's own leaf moved into the decoy's leaf, so that the
 decoy's misplacement is as mutual as a trap's. A search that keeps the
 out-of-cell points swapped both ways (to keep the traps) and drops the rest
-keeps such a decoy, and returns it.
+keeps such a decoy, and returns it. The BST has both too, on its keys
+(:func:`grading.instructors.lying_trees.bst_trap_swaps` and
+:func:`grading.instructors.lying_trees.bst_own_swap`): only the keys
+of childless nodes can move without changing where a search goes.
 """
 
 import numpy as np
@@ -133,35 +136,36 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
     rng = np.random.default_rng(81)
     keys = rng.uniform(0, 1000, 2000)
     left, right = trees.bst(keys)
-    traps = 0
+    traps = own = counters = 0
     for k, count, on_keys in ((1, 4, False), (5, 4, False), (12, 12, False), (5, 6, True)):
-        for query in rng.uniform(100, 900, count):
+        for turn, query in enumerate(rng.uniform(100, 900, count)):
             if on_keys:  # a query equal to a key of its path: the contract goes right first (equal keys go right)
-                query = keys[rng.choice(bst_path(keys, left, right, query))]
-            reached, margin = trees.bst_reach(keys, left, right, query, k)
+                query = keys[rng.choice(lying_trees.bst_descent(keys, left, right, query))]
+            # Every other query gets a counter-decoy (a decoy swapped both ways with the key of the node where
+            # the query's descent ends, C); the others a trap through C. The other traps avoid C.
+            partner = ("reached", "unreached")[turn % 2]
+            true_keys, pair = lying_trees.bst_own_swap(keys, left, right, query, k, partner=partner)
+            reached, margin = trees.bst_reach(true_keys, left, right, query, k)
             if margin < MARGIN:
                 continue
-            gaps = np.abs(keys - query)
+            gaps = np.abs(true_keys - query)
             nearest = np.min(gaps[gaps > 0])  # the decoys lie nearer than any other key, the query's own apart
-            trapped_keys, trapped = lying_trees.bst_trap_swaps(keys, left, right, query, k)
+            trapped_keys, trapped = lying_trees.bst_trap_swaps(true_keys, left, right, query, k)
             traps += len(trapped) // 2
-            lying = trapped_keys.copy()
             unreached = np.setdiff1d(np.arange(len(keys)), sorted(reached))
+            if pair is not None and partner == "reached":
+                own += 1
+                trapped = np.concatenate([trapped, pair])
+            elif pair is not None:
+                counters += 1  # U's ancestors keep their keys: U's interval is the true tree's
+                unreached = np.setdiff1d(unreached, lying_trees.bst_descent(keys, left, right, keys[pair[1]])[:-1])
+            lying = trapped_keys.copy()
             lying[unreached] = query + nearest * 1e-3 * (1 + np.arange(len(unreached)) / len(unreached))
             indices, _ = impl.bst_knn(lying, left, right, float(query), k)
             expected = np.lexsort((np.arange(len(keys)), np.abs(trapped_keys - query)))[:k]
             if as_list(indices, k) != expected.tolist():
                 raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"), expected, trapped)
-    assert traps >= 2, "the test needs traps on its queries"
-
-
-def bst_path(keys, left, right, query):
-    """The nodes the descent passes from the root (left when ``query < key``)."""
-    path, node = [], 0
-    while node >= 0:
-        path.append(node)
-        node = left[node] if query < keys[node] else right[node]
-    return path
+    assert traps >= 2 and own >= 2 and counters >= 2, "the test needs traps and counter-decoys on its queries"
 
 
 # -- k-d tree -------------------------------------------------------------------------------------

@@ -170,6 +170,11 @@ def cheats(function):
             "mutant sorted_array": (load(mutants / "sorted_array.py", function), READS),
             "mutant filters_by_interval": (load(mutants / "filters_by_interval.py", function), DROPS_KEYS),
             "filter (this file's import)": (_bst_filter.bst_knn, DROPS_KEYS),
+            "mutant keeps_swaps": (load(mutants / "keeps_swaps.py", function), READS),
+            "keeps swaps, but not its own node's (this file)": (
+                functools.partial(_bst_filter.bst_knn, mutual="but_its_own_leaf"),
+                DROPS_KEYS,
+            ),
         }
     return {
         "brute force": (brute_force(function), READS),
@@ -269,22 +274,38 @@ def test_on_a_trapped_tree_lawful_searches_read_within_their_reads_and_answer_ri
     assert partnered >= 5, f"too few decoys with a partner ({partnered})"
 
 
-def test_on_trapped_bst_keys_lawful_searches_read_within_their_reads_and_answer_right(rng):
+@pytest.mark.parametrize("partner", [None, "reached", "unreached"])
+def test_on_trapped_bst_keys_lawful_searches_read_within_their_reads_and_answer_right(partner, rng):
+    """As above, for the BST's traps and its swaps through the node where the query's descent ends (a trap
+    through it, or a counter-decoy): the traps make the rule read nothing new, a counter-decoy's partner
+    stays unread, and every lawful search answers as on the keys without decoys."""
     keys = rng.uniform(0, 1000, 1500)
     left, right = trees.bst(keys)
     searches = {name: search for name, search in lawful("bst_knn").items() if name != "reference"}
     planted = 0
     for query in rng.uniform(50, 950, 60):
         k = int(rng.integers(2, 30))
-        lying, swapped = lying_trees.bst_trap_swaps(keys, left, right, query, k)
-        planted += len(swapped) // 2
-        assert trees.bst_reach(lying, left, right, query, k)[0] <= trees.bst_reach(keys, left, right, query, k)[0]
+        true_keys, pair = (
+            (keys, None) if partner is None else lying_trees.bst_own_swap(keys, left, right, query, k, partner)
+        )
+        lying, swapped = lying_trees.bst_trap_swaps(true_keys, left, right, query, k)
+        planted += len(swapped) // 2 if partner is None else pair is not None
+        reached = trees.bst_reach(lying, left, right, query, k)[0]
+        assert reached <= trees.bst_reach(true_keys, left, right, query, k)[0]  # the traps read nothing new
         expected = np.lexsort((np.arange(len(keys)), np.abs(lying - query)))[:k]
+        if partner == "unreached" and pair is not None:
+            lying[pair[1]] = query  # the decoy: unread, so never returned
+            c, u = pair
+            assert u not in reached and u in _bst_filter.bst_knn(lying, left, right, query, k, mutual=True)[0]
         for name, search in searches.items():
             assert search(lying, left, right, query, k)[0].tolist() == expected.tolist(), name
-        if len(swapped):
+        if partner is None and len(swapped):
             assert swapped[0] in expected and swapped[0] not in _bst_filter.bst_knn(lying, left, right, query, k)[0]
-    assert planted >= 10, f"too few traps planted ({planted})"
+        if partner == "reached" and pair is not None:
+            c, u = pair
+            assert u in expected and u in _bst_filter.bst_knn(lying, left, right, query, k, mutual=True)[0]
+            assert u not in _bst_filter.bst_knn(lying, left, right, query, k, mutual="but_its_own_leaf")[0]
+    assert planted >= 10, f"too few swaps planted ({planted})"
 
 
 LOSERS = [("octree_radius", "stops_at_a_miss"), ("kdtree_radius", "strict_keep"), ("octree_knn", "strict_overlap")]

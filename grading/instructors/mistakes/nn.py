@@ -7,6 +7,7 @@ rule changed, or brute force over every point (what a library or a scan of
 the whole cloud gives).
 """
 
+import functools
 import math
 
 import numpy as np
@@ -57,6 +58,8 @@ KEEPS_SWAPS = (
     "they are swapped both ways: the contract says to trust the tree; read only what the rule reaches, and "
     "keep every point you read"
 )
+
+KEEPS_SWAPPED_KEYS = KEEPS_SWAPS.replace("point", "key").replace("cell", "interval")  # a BST holds keys
 
 
 def _cell_filters(case, mutual=False):
@@ -178,27 +181,10 @@ def bst_brute(keys, left, right, query, k):
     return rank.astype(np.int64), np.abs(keys[rank] - query)
 
 
-def bst_interval_filtered(keys, left, right, query, k):
-    """The interval-filter cheat: every node read, its key dropped if outside the node's interval (from its
-    ancestors' keys: below a key to the left, at or above it to the right), the k nearest of the rest.
-
-    Two codings: a child's interval nested in its parent's (the parent's key clipped to it), or the parent's
-    key taken as is (they differ under a node whose key lies outside its own interval)."""
-    keys, left, right, query, k = _bst_case(keys, left, right, query, k)
-
-    def filtered(nested):
-        kept, stack = [], [(0, -math.inf, math.inf)]
-        while stack:
-            node, lo, hi = stack.pop()
-            if lo <= keys[node] <= hi:
-                kept.append(node)
-            below, above = (min(hi, keys[node]), max(lo, keys[node])) if nested else (keys[node], keys[node])
-            stack += [(int(c), a, b) for c, a, b in ((left[node], lo, below), (right[node], above, hi)) if c >= 0]
-        kept = np.array(sorted(kept), dtype=np.int64)
-        rank = np.lexsort((kept, np.abs(keys[kept] - query)))[:k]
-        return kept[rank], np.abs(keys[kept[rank]] - query)
-
-    return Variants(filtered(nested) for nested in (True, False))
+def bst_interval_filtered(keys, left, right, query, k, mutual=False):
+    """The interval-filter cheat (:func:`tree_searches.bst_filtered_search`), in its two codings of an interval."""
+    case = _bst_case(keys, left, right, query, k)
+    return Variants(tree_searches.bst_filtered_search(*case, nested=n, mutual=mutual) for n in (True, False))
 
 
 BST_KNN = Model(
@@ -213,6 +199,7 @@ BST_KNN = Model(
             lambda keys, left, right, query, k: bst_knn(keys, left, right, query, k, strict=True),
         ),
         Mistake("filters_by_cell", FILTERS_BY_INTERVAL, bst_interval_filtered),
+        Mistake("keeps_swaps", KEEPS_SWAPPED_KEYS, functools.partial(bst_interval_filtered, mutual=True)),
         Mistake("finite_sentinel", FINITE_SENTINEL, _finite_sentinel(bst_knn, squared=False)),
         Mistake(
             "near_side_twice",
