@@ -9,7 +9,9 @@ tokens that the other holds too. Two kinds of text are boilerplate, and
 their hashes are removed before any comparison: the stubs' own text
 (docstrings, signatures, imports), which is in every submission, and any
 run found in more than half of the class's versions of the module (the
-way everyone writes ``as_points(points, ...)``), as MOSS's ``-m`` does.
+way everyone writes ``as_points(points, ...)``), as MOSS's ``-m`` does,
+near-copies counted once (a ring is never the majority that hides it); the
+report says how many runs of each module were left out so.
 
 Each entry of the class folder is read as ``batch`` and Gradescope read it
 (:func:`grading.instructors.gradescope.lay_over_stubs`: a clone, its
@@ -47,8 +49,12 @@ NOISE_TOKENS = 25  # copydetect's default k: shorter shared runs are noise
 # A fingerprint found in more than this share of a class's versions of a
 # module is the way everyone writes it (``x - x.mean(axis=0)``), not a copy:
 # it joins the boilerplate, as in MOSS's -m option. A pair is never common.
+# Copies do not vote: versions that share more than FAMILY_SHARE of the
+# smaller one's fingerprints are one family and count once, so that a ring
+# (3 copies among 5 students) is never the majority that hides it.
 COMMON_SHARE = 0.5
 COMMON_MIN_STUDENTS = 3
+FAMILY_SHARE = 0.8
 DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
 
@@ -90,14 +96,49 @@ def _fingerprints(module, texts, boilerplate):
     }
 
 
+def _families(hashes):
+    """The students grouped by near-copies (union of pairs sharing more than FAMILY_SHARE), each a list."""
+    students = sorted(hashes)
+    parent = {s: s for s in students}
+
+    def root(s):
+        while parent[s] != s:
+            parent[s] = parent[parent[s]]
+            s = parent[s]
+        return s
+
+    for a, b in itertools.combinations(students, 2):
+        smaller = min(len(hashes[a]), len(hashes[b]))
+        if smaller and len(hashes[a] & hashes[b]) > FAMILY_SHARE * smaller:
+            parent[root(a)] = root(b)
+    families = {}
+    for s in students:
+        families.setdefault(root(s), []).append(s)
+    return list(families.values())
+
+
 def _common_hashes(module, texts, boilerplate):
-    """The boilerplate plus every fingerprint too common in the class to mean copying."""
-    counts = Counter(
-        h for fingerprint in _fingerprints(module, texts, boilerplate).values() for h in fingerprint.hashes
-    )
-    limit = max(COMMON_MIN_STUDENTS - 1, COMMON_SHARE * len(texts))
+    """The boilerplate plus every fingerprint too common in the class to mean copying, and those alone.
+
+    A fingerprint counts once per family of near-copies (:func:`_families`)."""
+    hashes = {s: set(f.hashes) for s, f in _fingerprints(module, texts, boilerplate).items()}
+    families = [family for family in _families(hashes) if any(hashes[s] for s in family)]
+    counts = Counter(h for family in families for h in set().union(*(hashes[s] for s in family)))
+    limit = max(COMMON_MIN_STUDENTS - 1, COMMON_SHARE * len(families))
     common = [h for h, count in counts.items() if count > limit]
-    return np.unique(np.concatenate([np.asarray(boilerplate, dtype=np.int64), np.array(common, dtype=np.int64)]))
+    return np.unique(
+        np.concatenate([np.asarray(boilerplate, dtype=np.int64), np.array(common, dtype=np.int64)])
+    ), common
+
+
+def _common_line(module, common):
+    """The report's line on the code of ``module`` left out as common, or None if there is none."""
+    if not common:
+        return None
+    return (
+        f"{module}.py: {counted(len(common), 'code run')} written alike by most of the class (copies counted "
+        "once) left out as common, as the stubs' text is (MOSS's -m)"
+    )
 
 
 def _module_text(package, module):
@@ -160,7 +201,8 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     pairs : list of Pair
         Every compared pair with shared code, most similar first.
     skipped : list of str
-        One line per entry, or module of an entry, that was not compared, with why.
+        One line per entry, or module of an entry, that was not compared, with why, and one per module
+        whose code common to most of the class was left out.
     """
     boilerplate = _boilerplate_hashes(stubs)
     work = tempfile.mkdtemp(prefix="grading-similarity-")
@@ -171,7 +213,9 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     pairs = []
     for module in EXERCISE_MODULES:
         texts = {student: files[module] for student, files in modules.items() if module in files}
-        fingerprints = _fingerprints(module, texts, _common_hashes(module, texts, boilerplate))
+        left_out, common = _common_hashes(module, texts, boilerplate)
+        fingerprints = _fingerprints(module, texts, left_out)
+        skipped += [line for line in [_common_line(module, common)] if line]
         for first, second in itertools.combinations(sorted(fingerprints), 2):
             a, b = fingerprints[first], fingerprints[second]
             tokens, (share_a, share_b), (slices_a, slices_b) = compare_files(a, b)

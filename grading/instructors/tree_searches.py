@@ -144,6 +144,7 @@ def octree_search(
     contained_at_radius=False,
     code_from_x=False,
     upper_on_plane=False,
+    every_column=False,
 ):
     """The contract's octree search of every query (kNN with ``k``, CSR with ``radius``).
 
@@ -162,10 +163,14 @@ def octree_search(
     ``contained_at_radius`` (a contained octant's points reported at distance
     r, not their own), ``code_from_x`` (kNN: the query's own child code
     computed with x for all three bits, so 0 or 7), ``upper_on_plane`` (kNN:
-    the own code by ``q >= c``, so a query on a centre plane starts in the upper child).
+    the own code by ``q >= c``, so a query on a centre plane starts in the upper child),
+    ``every_column`` (a point's distance over every column, an intensity too, while the cubes are xyz).
     """
-    xyz = np.asarray(points, dtype=float)[:, :3]
-    queries = np.asarray(queries, dtype=float).reshape(len(queries), -1)[:, :3]
+    measured = np.asarray(points, dtype=float)
+    rows = np.asarray(queries, dtype=float).reshape(len(queries), -1)
+    xyz, queries = measured[:, :3], rows[:, :3]
+    if not every_column:
+        measured, rows = xyz, queries
     results = []
 
     def meets(query, node, w2):
@@ -176,13 +181,13 @@ def octree_search(
             return float(np.sum((np.abs(query - c) - e) ** 2)) <= w2
         return cell_gap_squared(query, c, e) < w2 if strict else cell_gap_squared(query, c, e) <= w2
 
-    for query in queries:
+    for query, row in zip(queries, rows):
         best = _best(k, sentinel) if k is not None else None
         found = []
 
-        def offer(node, everything=False, query=query, best=best, found=found):
+        def offer(node, everything=False, row=row, best=best, found=found):
             indices = tree["order"][tree["start"][node] : tree["stop"][node]]
-            s = squared_distances(xyz[indices], query)
+            s = squared_distances(measured[indices], row)
             if best is not None:
                 best.offer_all(s, indices)
             else:

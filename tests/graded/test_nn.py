@@ -90,6 +90,16 @@ def brute_radius(points, queries, radius):
     return rows
 
 
+def with_intensity(points, queries, seed):
+    """``points`` and ``queries`` with a fourth column, an intensity in [0, 100): an octree searches xyz only,
+    so a search that measures distances over every column answers wrong."""
+    rng = np.random.default_rng(seed)
+    return (
+        np.hstack([points, rng.uniform(0, 100, (len(points), 1))]),
+        np.hstack([queries, rng.uniform(0, 100, (len(queries), 1))]),
+    )
+
+
 def two_clusters(n, seed, dim=3):
     """``n`` points in the cube [-1, 1]^dim, then ``n`` more 100 away along the first axis: for a query
     well inside the first cluster, the contract's rule never reads the second (its cells lie some 50 away)."""
@@ -425,6 +435,7 @@ def test_kdtree_knn_matches_brute_force(impl):
         (cube(2000, 31), cube(60, 32), 8, 16),
         (scan_like(2000, 33), scan_like(60, 34) + 0.05, 5, 8),
         (cube(1500, 35, dim=2), cube(50, 36, dim=2) * 1.2, 12, 4),
+        (cube(1200, 301, dim=5), cube(40, 302, dim=5), 6, 8),  # D > 3: a k-d tree has any number of axes
     ):
         tree = kd_tree(impl, points, leaf)
         check_knn(*impl.kdtree_knn(tree, points, queries, k), *brute_knn(points, queries, k), "kdtree_knn")
@@ -491,6 +502,7 @@ def test_kdtree_radius_matches_brute_force(impl):
         (cube(2000, 41), cube(50, 42), 0.2, 16),
         (scan_like(2000, 43), scan_like(50, 44), 0.5, 8),
         (cube(1000, 45, dim=2), cube(40, 46, dim=2), 0.1, 3),
+        (cube(1200, 303, dim=4), cube(40, 304, dim=4), 0.5, 8),  # D > 3
     ):
         tree = kd_tree(impl, points, leaf)
         check_csr(impl.kdtree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
@@ -603,9 +615,11 @@ def test_octree_radius_matches_brute_force(impl):
         (cube(2000, 61), cube(50, 62) * 1.3, 0.25, 8),  # some queries outside the root cube
         (scan_like(2000, 63), scan_like(50, 64), 0.6, 16),
         (cube(1000, 65), cube(30, 66), 1.5, 4),  # large balls: whole octants inside
+        (*with_intensity(cube(1200, 305), cube(40, 306), 307), 0.3, 8),  # xyz and an intensity, not a coordinate
     ):
         tree = oc_tree(impl, points, leaf)
-        check_csr(impl.octree_radius(tree, points, queries, radius), brute_radius(points, queries, radius))
+        expected = brute_radius(points[:, :3], queries[:, :3], radius)
+        check_csr(impl.octree_radius(tree, points, queries, radius), expected)
 
 
 @pytest.mark.grades("octree_radius")
@@ -642,9 +656,11 @@ def test_octree_knn_matches_brute_force(impl):
         (scan_like(2000, 73), scan_like(50, 74), 5, 16),
         (cube(300, 75), cube(20, 76), 300, 4),  # k = N
         (*far_cloud(300, 78), 20, 8),  # UTM-like coordinates, the k-th neighbour 1e11 away
+        (*with_intensity(cube(1200, 308), cube(40, 309), 310), 6, 8),  # xyz and an intensity, not a coordinate
     ):
         tree = oc_tree(impl, points, leaf)
-        check_knn(*impl.octree_knn(tree, points, queries, k), *brute_knn(points, queries, k), "octree_knn")
+        expected = brute_knn(points[:, :3], queries[:, :3], k)
+        check_knn(*impl.octree_knn(tree, points, queries, k), *expected, "octree_knn")
 
 
 @pytest.mark.grades("octree_knn")

@@ -206,8 +206,12 @@ def _octree_search(
     contained_at_radius=False,
     code_from_x=False,
     upper_on_plane=False,
+    measured=None,
+    row=None,
 ):
-    held = _slots(k, sentinel) if k is not None else []  # (squared distance, index), sorted
+    held = _slots(k, sentinel) if k is not None else []
+    # A point's distance is measured on ``measured`` and ``row`` (xyz and the query unless given).
+    measured, row = (xyz, query) if measured is None else (measured, row)  # (squared distance, index), sorted
 
     def bound():
         if k is None:
@@ -217,7 +221,7 @@ def _octree_search(
     def offer(node, everything=False):
         nonlocal held
         for index in tree["order"][tree["start"][node] : tree["stop"][node]]:
-            s = float(np.sum((xyz[index] - query) ** 2))
+            s = float(np.sum((measured[index] - row) ** 2))
             if k is not None:
                 held = sorted([*held, (s, int(index))])[:k]
             elif everything and contained_at_radius:  # every point of a contained octant "at the radius"
@@ -269,13 +273,19 @@ def octree_knn(
     unclamped=False,
     code_from_x=False,
     upper_on_plane=False,
+    every_column=False,
 ):
     """kNN rows of a plain recursive octree search (Behley's order and early termination by default);
     ``sentinel``: the starting worst squared distance and padding (as :func:`bst_knn`); ``upper_on_plane``:
-    the query's own child code by ``q >= c`` (a query on a centre plane starts in the upper child)."""
-    xyz = np.asarray(points, dtype=float)[:, :3]
+    the query's own child code by ``q >= c`` (a query on a centre plane starts in the upper child);
+    ``every_column``: a point's distance over every column (an intensity too), the cubes' on xyz."""
+    points = np.asarray(points, dtype=float)
+    xyz = points[:, :3]
     flags = (True, early, own_first, box, strict, False, sentinel, False, unclamped, False, code_from_x, upper_on_plane)
-    rows = [_octree_search(tree, xyz, q[:3], k, None, *flags) for q in np.asarray(queries, dtype=float)]
+    rows = [
+        _octree_search(tree, xyz, q[:3], k, None, *flags, **({"measured": points, "row": q} if every_column else {}))
+        for q in np.asarray(queries, dtype=float)
+    ]
     return _knn_arrays(rows, k)
 
 

@@ -123,7 +123,8 @@ def test_the_renamed_copy_ranks_first_and_independent_solutions_stay_below(plant
     ]
     # The stub's text is boilerplate: untouched stubs never pair.
     assert not [p for p in pairs if {p.first, p.second} == {"erin", "frank"}]
-    assert skipped == ["mallory: not compared: pcl_course/pca.py is a symbolic link: submit regular files only"]
+    assert skipped[0] == "mallory: not compared: pcl_course/pca.py is a symbolic link: submit regular files only"
+    assert [line.split(":")[0] for line in skipped[1:]] == ["pca.py"]  # the code all write alike, left out
 
 
 def test_the_report_is_one_self_contained_page_with_the_shared_code_marked(planted_class, tmp_path):
@@ -146,7 +147,7 @@ def test_the_report_is_one_self_contained_page_with_the_shared_code_marked(plant
         timeout=SUBPROCESS_BACKSTOP,
     )
     assert completed.returncode == 0, completed.stderr
-    first_line = completed.stdout.splitlines()[1]
+    first_line = next(line for line in completed.stdout.splitlines() if re.match(r"\s*\d+%", line))
     assert re.fullmatch(r"\s*\d+%\s+pca\.py\s+alice\s+bob", first_line), completed.stdout
     page = report.read_text()
     assert 'id="pair-1"><h2>1. pca.py: alice and bob' in page
@@ -218,7 +219,7 @@ def test_every_layout_graded_is_compared_as_python_decodes_it_and_every_entry_le
     assert min(found.values()) > 0.9, (found, similarity, skipped)
     copies = {("alice", "bob"), ("carol", "dave")}
     assert all(s < DISPLAY_THRESHOLD for key, s in similarity.items() if key[1:] not in copies), similarity
-    assert len(skipped) == 4, skipped
+    assert len(skipped) == 5 and skipped[4].startswith("pca.py: "), skipped  # the code all write alike, left out
     assert skipped[0].startswith("erin: pca.py not compared: its bytes cannot be decoded as Python decodes them")
     assert skipped[1] == "frank.txt: not compared: not a folder (a link or a file)"
     assert skipped[2].startswith("gina: not compared: nothing to grade (expected pca.py, ")
@@ -233,3 +234,18 @@ def test_the_report_shows_students_control_characters_escaped():
     page = render_report([hostile], ["name\x1b[2J: not compared: not a folder"], threshold=0)
     assert not [c for c in page if c not in "\n" and unicodedata.category(c) in ("Cc", "Cf", "Cs", "Zl", "Zp")]
     assert "esc\\x1b]0;owned\\x07" in page and "bidi\\u202egnp" in page and "\\u202e}\\u2066" in page
+
+
+def test_a_ring_in_a_small_class_is_shown_for_copies_count_once_in_the_common_code(tmp_path):
+    """Three copies among five students are a majority of the versions, but one family: every pair of the
+    ring is shown (issue 35's hostile review), and code all five write alike is still left out, with a line."""
+    for name in ("ann", "ben", "cat"):
+        student(tmp_path, name, ALICE)
+    student(tmp_path, "carol", CAROL)
+    student(tmp_path, "dave", DAVE)
+    pairs, skipped = compare_class(tmp_path)
+    ring = {frozenset((p.first, p.second)) for p in pairs if p.module == "pca" and p.similarity > 0.8}
+    assert ring == {frozenset(pair) for pair in (("ann", "ben"), ("ann", "cat"), ("ben", "cat"))}
+    others = [p for p in pairs if not {p.first, p.second} <= {"ann", "ben", "cat"}]
+    assert all(p.similarity < DISPLAY_THRESHOLD for p in others), [(p.first, p.second, p.similarity) for p in others]
+    assert all(re.fullmatch(r"pca\.py: \d+ code runs? written alike by most of the class .*", line) for line in skipped)

@@ -537,6 +537,12 @@ OCTREE_KNN = Model(
             "centre plane starts in the other child, and reads nodes in another order than the rule",
             lambda tree, points, queries, k: octree_knn(tree, points, queries, k, upper_on_plane=True),
         ),
+        Mistake(
+            "every_column",
+            "an octree searches xyz: a point's distance is over its first three columns, as the cubes' are; "
+            "yours counts the extra columns too (an intensity is not a coordinate)",
+            lambda tree, points, queries, k: octree_knn(tree, points, queries, k, every_column=True),
+        ),
     ),
 )
 
