@@ -27,18 +27,23 @@ Write the Gradescope autograder archive (``grading/instructors/gradescope.py``):
 
     python -m grading gradescope _build/gradescope/autograder.zip
 
-The exit status is 0 whenever grading ran, whatever the score; 2 for a usage
-error (no ``pcl_course/`` found, no test selected); 1 if pytest itself broke.
+Exit status: 0 whenever grading ran, whatever the score (``--require-full``:
+1 unless every selected test passed); 2 for a usage error (a folder that does
+not exist, no ``pcl_course/`` found, no test selected, a bad option); 1 if
+grading could not run (pytest itself broke, no isolation where it is required).
 """
 
 import argparse
 import json
 import os
+import platform
 import sys
 import tempfile
+from importlib import metadata
 from pathlib import Path
 
 from grading import ASSIGNMENTS, REPO_ROOT, instructors_grader
+from grading.errors import UsageError, existing_folder
 from grading.options import SHARED
 from grading.results import Grading
 from grading.runner import PYTEST_EXIT_NO_TESTS, PYTEST_EXIT_USAGE, run_graded_tests
@@ -50,11 +55,11 @@ def find_package(submission):
     Symbolic links are not followed here: staging (grading/staging.py)
     refuses a linked ``pcl_course`` with one clear line.
     """
-    submission = Path(os.path.abspath(submission))
+    submission = existing_folder(os.path.abspath(submission))
     for candidate in (submission / "pcl_course", submission):
         if candidate.name == "pcl_course" and os.path.lexists(candidate):
             return candidate
-    raise SystemExit(f"error: no pcl_course/ package found in {submission}")
+    raise UsageError(f"no pcl_course/ package found in {submission}")
 
 
 def grade(args):
@@ -63,7 +68,7 @@ def grade(args):
     elif args.submission:
         impl_dir = find_package(args.submission)
     else:
-        raise SystemExit("error: give a SUBMISSION directory or --reference")
+        raise UsageError("give a SUBMISSION folder or --reference")
     results = Path(args.results) if args.results else Path(tempfile.mkdtemp()) / "results.json"
     # The reference and the project's own wrong submissions are trusted code;
     # a student's submission runs in the sandbox.
@@ -124,6 +129,27 @@ def _commands():
     return commands
 
 
+VERSIONED = ("numpy", "scipy", "numba", "pytest")  # what a grading's outcome depends on, besides the grader
+
+
+def version():
+    """One line: the grader's version (the course package's) and the versions its marks depend on."""
+
+    def of(name):
+        try:
+            return metadata.version(name)
+        except metadata.PackageNotFoundError:
+            return "not installed"
+
+    grader = of("pcl-course")
+    if grader == "not installed" and (REPO_ROOT / "pyproject.toml").is_file():  # a student's clone, not installed
+        import tomllib
+
+        grader = tomllib.loads((REPO_ROOT / "pyproject.toml").read_text())["project"]["version"]
+    packages = ", ".join(f"{name} {of(name)}" for name in VERSIONED)
+    return f"grading {grader} (Python {platform.python_version()}; {packages})"
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     commands = _commands()
@@ -134,9 +160,22 @@ def main(argv=None):
             file=sys.stderr,
         )
         return 2
-    parser = argparse.ArgumentParser(prog="python -m grading", description=__doc__.split("\n")[0])
+    examples = __doc__[__doc__.index("Examples") :].replace("::\n", ":\n")
+    if not instructors_grader():  # a student's copy: its examples and statuses of `grade` only
+        examples = examples[: examples.index("Grade a whole class")] + examples[examples.index("Exit status") :]
+    parser = argparse.ArgumentParser(
+        prog="python -m grading",
+        description=__doc__.split("\n")[0],
+        epilog=examples,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--version", action="version", version=version())
     subparsers = parser.add_subparsers(dest="command", required=True)
     for name, (help_text, arguments, _) in commands.items():
         arguments(subparsers.add_parser(name, help=help_text))
     args = parser.parse_args(argv)
-    return commands[args.command][2](args)
+    try:
+        return commands[args.command][2](args)
+    except UsageError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2

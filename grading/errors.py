@@ -4,7 +4,24 @@ Each carries a message written for the student: one line that says what went
 wrong and, where it can, what to do.
 """
 
+from pathlib import Path
+
 from grading.config import FORBIDDEN_IN_MODULE
+
+
+class UsageError(Exception):
+    """A command given what it cannot use (a folder that does not exist, an empty class): one line,
+    ``error: ...``, and exit status 2, as argparse's own usage errors."""
+
+
+def existing_folder(path, what="folder"):
+    """``path`` as a Path if it is a folder; else :class:`UsageError` saying it is missing or not a folder."""
+    path = Path(path)
+    if not path.exists():
+        raise UsageError(f"no such {what}: {path}")
+    if not path.is_dir():
+        raise UsageError(f"{path} is not a folder")
+    return path
 
 
 class SandboxError(Exception):

@@ -24,7 +24,7 @@ from pathlib import Path
 import yaml
 
 from grading import ASSIGNMENTS, config
-from grading.errors import NothingToGrade, StagingError
+from grading.errors import NothingToGrade, StagingError, UsageError, existing_folder
 from grading.instructors.gradebook import write_gradebook
 from grading.instructors.gradescope import assemble
 from grading.instructors.reports import csv_report, say
@@ -217,7 +217,7 @@ def class_folders(root):
     """
     entries = sorted(p for p in root.iterdir() if not p.name.startswith(".") and p.name != GRADESCOPE_METADATA)
     if not entries:
-        raise SystemExit(f"error: {root} is empty")
+        raise UsageError(f"{root} is empty: no submission to grade")
     return entries
 
 
@@ -256,7 +256,7 @@ def batch(args):
     entry whose grading breaks the grader itself is recorded as ``grading
     failed``: the class's marks are never lost to one entry.
     """
-    root = Path(args.directory).resolve()
+    root = existing_folder(args.directory).resolve()
     entries = class_folders(root)
     metadata, problems = read_gradescope_metadata(root)
     for line in problems:

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from grading import ASSIGNMENTS
+from grading.errors import existing_folder
 
 
 def _batch_arguments(parser):
@@ -144,9 +145,7 @@ def _similarity(args):
     from grading.instructors.reports import say
     from grading.instructors.similarity import DISPLAY_THRESHOLD, compare_class, counted, render_report
 
-    root = Path(args.directory)
-    if not root.is_dir():
-        raise SystemExit(f"error: {root} is not a folder")
+    root = existing_folder(args.directory)
     threshold = DISPLAY_THRESHOLD if args.threshold is None else args.threshold
     pairs, skipped = compare_class(root)
     report = Path(args.report)
