@@ -339,7 +339,7 @@ def release(out_dir, course_repository=None, course_ref=None):
     cut_reference_link(out / "pcl_course")
     (out / "_config.yml").write_text(_student_config((REPO_ROOT / "_config.yml").read_text()))
     (out / "pyproject.toml").write_text(_student_pyproject((REPO_ROOT / "pyproject.toml").read_text()))
-    for name in ("Makefile", "README.md"):
+    for name in ("Makefile", "README.md", "requirements.txt"):
         shutil.copy2(TEMPLATES / name, out / name)
     (out / CHECK_SCRIPT).parent.mkdir(parents=True)
     shutil.copy2(TEMPLATES / Path(CHECK_SCRIPT).name, out / CHECK_SCRIPT)

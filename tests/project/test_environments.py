@@ -80,3 +80,15 @@ def test_the_pins_resolve_for_the_oldest_supported_python(name, platform, binary
     command += ["--only-binary", ":all:"] if binary_only else []
     completed = subprocess.run(command, capture_output=True, text=True, timeout=SUBPROCESS_BACKSTOP)
     assert completed.returncode == 0, completed.stderr[-2000:]
+
+
+def _requirement_lines(path):
+    return [line.strip() for line in path.read_text().splitlines() if line.strip() and not line.startswith("#")]
+
+
+def test_the_top_level_requirements_file_installs_the_whole_course_from_the_lock():
+    """``pip install -r requirements.txt`` is what users type (issue 37, item 6): it names the lock, and only it,
+    so re-pinning never leaves it behind; the student repository's names its subset (test_release)."""
+    assert _requirement_lines(REPO_ROOT / "requirements.txt") == ["-r requirements/course.txt"]
+    template = REPO_ROOT / "grading" / "instructors" / "templates" / "requirements.txt"
+    assert _requirement_lines(template) == ["-r requirements/student.txt"]

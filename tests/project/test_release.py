@@ -72,6 +72,8 @@ def test_the_release_holds_what_students_need_and_nothing_else(release_dir):
             REPO_ROOT / "pcl_course" / f"{module}.py"
         ).read_bytes()
     assert "REFERENCE_PACKAGE = None" in (release_dir / "pcl_course" / "book.py").read_text()
+    top = [line for line in (release_dir / "requirements.txt").read_text().splitlines() if not line.startswith("#")]
+    assert top == ["-r requirements/student.txt"]  # pip install -r requirements.txt: the student's set
 
 
 def test_instructor_solutions_are_removed_and_self_check_answers_kept(release_dir):
