@@ -41,7 +41,7 @@ from copydetect.utils import highlight_overlap
 from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
 from grading.forbidden import read_source
-from grading.instructors.batch import class_folders
+from grading.instructors.batch import class_folders, read_gradescope_metadata
 from grading.instructors.gradescope import lay_over_stubs
 from grading.results import clean
 
@@ -184,6 +184,13 @@ def _student_modules(class_dir, into):
     return modules, skipped
 
 
+def submitted_by(folder, submitters=None):
+    """A submission's label: its submitters' names (or emails, or SIDs) from Gradescope's metadata, then
+    its folder in brackets (``Ann Lee (submission_4711)``); the folder alone without metadata."""
+    names = [p["name"] or p["email"] or p["sid"] for p in submitters or ()]
+    return f"{', '.join(n for n in names if n)} ({folder})" if any(names) else folder
+
+
 def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     """Compare every pair of students' versions of each exercise module.
 
@@ -192,7 +199,8 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     class_dir : path
         One entry per submission, in any layout ``python -m grading batch``
         grades (a clone, its ``pcl_course/``, loose modules, Gradescope's
-        export).
+        export, whose ``submission_metadata.yml`` names the submitters:
+        :func:`submitted_by`).
     stubs : path
         The stubs whose text is boilerplate (default: the course's).
 
@@ -210,6 +218,9 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
         modules, skipped = _student_modules(class_dir, work)
     finally:
         shutil.rmtree(work, ignore_errors=True)
+    people, problems = read_gradescope_metadata(Path(class_dir))
+    skipped = problems + skipped
+    modules = {submitted_by(folder, people.get(folder)): files for folder, files in modules.items()}
     pairs = []
     for module in EXERCISE_MODULES:
         texts = {student: files[module] for student, files in modules.items() if module in files}

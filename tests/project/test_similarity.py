@@ -249,3 +249,27 @@ def test_a_ring_in_a_small_class_is_shown_for_copies_count_once_in_the_common_co
     others = [p for p in pairs if not {p.first, p.second} <= {"ann", "ben", "cat"}]
     assert all(p.similarity < DISPLAY_THRESHOLD for p in others), [(p.first, p.second, p.similarity) for p in others]
     assert all(re.fullmatch(r"pca\.py: \d+ code runs? written alike by most of the class .*", line) for line in skipped)
+
+
+def test_gradescope_submissions_are_named_by_their_submitters(tmp_path):
+    """A Gradescope export's folders are submission ids: the report names the submitters from
+    ``submission_metadata.yml`` (issue 37, item 7), the folder kept in brackets, escaped as every name is."""
+    student(tmp_path, "submission_4711", ALICE)
+    student(tmp_path, "submission_4712", ALICE)
+    student(tmp_path, "submission_4713", DAVE)
+    (tmp_path / "submission_metadata.yml").write_text(
+        "submission_4711:\n  :submitters:\n  - :name: Dana Scully\n    :sid: S-4\n    :email: dana@example.edu\n"
+        "submission_4712:\n  :submitters:\n  - :name: ''\n    :sid: S-5\n    :email: fox@example.edu\n"
+        '  - :name: "Walter\\e[8m Skinner"\n    :sid: S-6\n    :email: ws@example.edu\n'
+    )
+    pairs, skipped = compare_class(tmp_path)
+    first = pairs[0]
+    assert {first.first, first.second} == {
+        "Dana Scully (submission_4711)",
+        "fox@example.edu, Walter\x1b[8m Skinner (submission_4712)",
+    }
+    assert any(p.first == "submission_4713" or p.second == "submission_4713" for p in pairs) or not pairs[1:]
+    from grading.instructors.similarity import render_report
+
+    page = render_report(pairs, skipped)
+    assert "Dana Scully (submission_4711)" in page and "\x1b" not in page
