@@ -37,6 +37,7 @@ import argparse
 import json
 import os
 import platform
+import shutil
 import sys
 import tempfile
 from importlib import metadata
@@ -82,7 +83,12 @@ def grade(args):
             return 1
     passed = {option.dest: getattr(args, option.dest) for option in SHARED}
     passed["function"] = [*args.function, *ASSIGNMENTS.get(args.assignment, ())]
-    code, output = run_graded_tests(impl_dir, results, keyword=args.k, junit=args.junit, sandbox=sandbox, **passed)
+    progress = None if args.quiet or not sys.stderr.isatty() else ProgressLine(sys.stderr)
+    code, output = run_graded_tests(
+        impl_dir, results, keyword=args.k, junit=args.junit, sandbox=sandbox, progress=progress, **passed
+    )
+    if progress is not None:
+        progress.close()
     if code == PYTEST_EXIT_NO_TESTS:
         print(f"error: no graded test matches -k {args.k!r}", file=sys.stderr)
         return 2
@@ -103,6 +109,23 @@ def grade(args):
     return 0
 
 
+class ProgressLine:
+    """One terminal line rewritten as each graded test finishes: ``[37/120] 42 s  test_name``."""
+
+    def __init__(self, stream):
+        self.stream = stream
+
+    def __call__(self, done, total, seconds, test, score):
+        line = f"[{done}/{total}] {seconds:.0f} s  {test}"
+        width = shutil.get_terminal_size().columns - 1
+        self.stream.write("\r\x1b[K" + line[:width])
+        self.stream.flush()
+
+    def close(self):
+        self.stream.write("\r\x1b[K")  # the table follows on a clean line
+        self.stream.flush()
+
+
 def _grade_arguments(parser):
     parser.add_argument("submission", nargs="?", help="a student's clone (holding pcl_course/)")
     parser.add_argument("--reference", action="store_true", help="grade solutions/ instead")
@@ -115,6 +138,9 @@ def _grade_arguments(parser):
         help="grade only this assignment's functions (one per lecture; default: every graded function)",
     )
     parser.add_argument("--require-full", action="store_true", help="exit 1 unless every selected test passed")
+    parser.add_argument(
+        "--quiet", action="store_true", help="no progress line while grading (there is none off a terminal)"
+    )
     for option in SHARED:  # passed through to the grading process (grading/options.py)
         option.add_to(parser)
 

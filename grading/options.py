@@ -94,6 +94,11 @@ PLUGIN_ONLY = (
         {"default": None, "metavar": "TEXT"},
     ),
     Option(
+        "--progress-fd",
+        "a pipe to write one line to as each graded test finishes (`done/total seconds test score/max`)",
+        {"type": int, "default": None, "metavar": "FD"},
+    ),
+    Option(
         "--grading-options",
         "a JSON file of options (impl, results, submission_note) that name a submission's paths: kept off the "
         "command line, which any process can read in /proc",

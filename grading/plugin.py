@@ -60,6 +60,7 @@ def pytest_configure(config):
 
 
 _OPTIONS_KEY = pytest.StashKey[dict]()
+_PROGRESS_KEY = pytest.StashKey[object]()  # the --progress-fd pipe, as a line-buffered text file
 
 
 def grading_option(config, name):
@@ -245,7 +246,26 @@ def pytest_collection_finish(session):
         prefix = f"{grading_config.ASSIGNMENT_NUMBERS[function]}." if several else ""
         results[item.nodeid] = _new_result(item, prefix + number)
     session.config.stash[_STARTED_KEY] = time.monotonic()
+    fd = session.config.getoption("--progress-fd")
+    if fd is not None and not hasattr(session.config, "workerinput"):
+        session.config.stash[_PROGRESS_KEY] = {"pipe": os.fdopen(fd, "w", buffering=1), "done": 0}
     _write_results(session.config, final=False)
+
+
+def _report_progress(config, result):
+    """One line on the progress pipe as a graded test finishes: ``done/total seconds test score/max``."""
+    progress = config.stash.get(_PROGRESS_KEY, None)
+    if progress is None:
+        return
+    progress["done"] += 1
+    total = len(config.stash[_RESULTS_KEY])
+    elapsed = time.monotonic() - config.stash[_STARTED_KEY]
+    try:
+        progress["pipe"].write(
+            f"{progress['done']}/{total} {elapsed:.0f} {result.name} {result.score:g}/{result.max_score:g}\n"
+        )
+    except OSError:  # the reader is gone: progress is a courtesy, never a reason to stop grading
+        config.stash[_PROGRESS_KEY] = None
 
 
 def _over_budget(config):
@@ -323,6 +343,7 @@ def pytest_runtest_makereport(item, call):
         result.set_feedback(reason if reason.startswith("not run:") else "skipped")
     if report.when == "teardown":  # once per test, its verdict final
         _write_results(item.config, final=False)
+        _report_progress(item.config, result)
 
 
 def grading_of(config):

@@ -11,6 +11,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 
 from grading import GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT
 from grading.options import pytest_arguments
@@ -19,11 +20,14 @@ PYTEST_EXIT_NO_TESTS = 5
 PYTEST_EXIT_USAGE = 4
 
 
-def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None, note=None, **options):
+def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None, note=None, progress=None, **options):
     """Run the graded tests on ``impl_dir`` in a pytest process; return its exit code and its output.
 
     ``options`` are the grading process's own (:mod:`grading.options`, by
     their dest: ``budget``, ``function``, ``sandbox``, ``sandbox_uid``, ...).
+    ``progress``, if given, is called with ``(done, total, seconds, test,
+    score)`` as each graded test finishes (read from a pipe the grading
+    process writes one line to per test, ``--progress-fd``).
     The paths that name a submission (its folder, its results file) and the
     note on it go to pytest in a file only the grader's user can read, not
     on its command line: any process, a submission graded beside this one
@@ -62,17 +66,39 @@ def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None,
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
     folder = tempfile.mkdtemp(prefix="grading-options-")  # mode 0700: the grader's user only
     options_file = os.path.join(folder, "options.json")
+    reader = writer = None
+    if progress is not None:
+        reader, writer = os.pipe()
+        command += ["--progress-fd", str(writer)]
     try:
         with open(os.open(options_file, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600), "w") as handle:
             json.dump({"impl": str(impl_dir), "results": str(results), "submission_note": note}, handle)
-        completed = subprocess.run(
+        process = subprocess.Popen(
             [*command, "--grading-options", options_file],
             cwd=REPO_ROOT,
             env=env,
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
             text=True,
+            pass_fds=(writer,) if writer is not None else (),
         )
+        listener = None
+        if writer is not None:
+            os.close(writer)  # the grading process holds it now: the pipe ends when that process does
+            listener = threading.Thread(target=_relay_progress, args=(reader, progress), daemon=True)
+            listener.start()
+        output, _ = process.communicate()
+        if listener is not None:
+            listener.join()
     finally:
         shutil.rmtree(folder, ignore_errors=True)
-    return completed.returncode, completed.stdout
+    return process.returncode, output
+
+
+def _relay_progress(reader, progress):
+    """Call ``progress`` for each line of the grading process's progress pipe, until it closes."""
+    with os.fdopen(reader) as lines:
+        for line in lines:
+            counts, seconds, test, score = line.split()
+            done, total = counts.split("/")
+            progress(int(done), int(total), float(seconds), test, score)

@@ -17,6 +17,8 @@ import queue
 import stat
 import sys
 import tempfile
+import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -246,6 +248,12 @@ def marks_row(folder, functions):
     ]
 
 
+def _mark_line(folder):
+    """``name: 7 / 10``, or ``name: not graded (why)``."""
+    mark = f"{folder.grading.score:g} / {folder.grading.max_score:g}" if folder.grading else folder.status
+    return f"{folder.name}: {mark}" + ("" if folder.grading else f" ({folder.note})" if folder.note else "")
+
+
 def batch(args):
     """``python -m grading batch``: grade every entry of a class folder (see the module docstring).
 
@@ -327,13 +335,22 @@ def batch(args):
         return folder, output
 
     def account_for(entry):
+        started = time.monotonic()
         try:
-            return grade_one(entry)
+            folder, output = grade_one(entry)
         except Exception as exc:  # one entry the grader could not handle never costs the others their rows
-            folder = Folder(entry.name, metadata.get(entry.name, []))
+            folder, output = Folder(entry.name, metadata.get(entry.name, [])), ""
             folder.status = "grading failed"
             folder.note = f"the grader broke on this entry: {type(exc).__name__}: {exc}"
-            return folder, ""
+        if progress:  # as each finishes, whatever its place in name order
+            with finished_lock:
+                finished.append(entry)
+                say(f"[{len(finished)}/{len(entries)}] {_mark_line(folder)} ({time.monotonic() - started:.0f} s)")
+        return folder, output
+
+    # On a terminal, a line as each submission finishes; in a log, a line per submission in name order.
+    progress = not args.quiet and sys.stdout.isatty()
+    finished, finished_lock = [], threading.Lock()
 
     # The columns: every function of the assignment (empty where -k left it out).
     functions = list(ASSIGNMENTS[args.assignment])
@@ -345,8 +362,8 @@ def batch(args):
         for folder, output in pool.map(account_for, entries):
             folders.append(folder)
             marks.writerow(marks_row(folder, functions))
-            mark = f"{folder.grading.score:g} / {folder.grading.max_score:g}" if folder.grading else folder.status
-            say(f"{folder.name}: {mark}" + ("" if folder.grading else f" ({folder.note})" if folder.note else ""))
+            if not progress:
+                say(_mark_line(folder))
             if folder.status == "grading failed" and output:
                 say(output, file=sys.stderr, newlines=True, limit=config.MAX_TEXT * 10)
     if args.gradebook:

@@ -30,6 +30,11 @@ def _batch_arguments(parser):
     parser.add_argument("--out", help="folder for the per-submission results files (default: DIRECTORY-results)")
     parser.add_argument("--jobs", type=int, help="submissions graded at once (default: number of cores)")
     parser.add_argument("-k", help="select tests as pytest -k does")
+    parser.add_argument(
+        "--quiet",
+        action="store_true",
+        help="on a terminal, list the submissions in name order at the end, not one line as each finishes",
+    )
     parser.add_argument("--gradebook", metavar="CSV", help="also write the totals in Canvas's gradebook layout here")
     parser.add_argument(
         "--gradebook-column",
