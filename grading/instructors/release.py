@@ -19,7 +19,7 @@ from pathlib import Path
 
 import yaml
 
-from grading import HIDDEN_TESTS, REPO_ROOT
+from grading import ASSIGNMENTS, HIDDEN_TESTS, REPO_ROOT
 from grading.hidden import POINTS_FILE, write_points_file
 from grading.instructors.leakcheck import find_leaks
 from grading.instructors.shipping import IGNORED, WITHHELD, cut_reference_link, substitute
@@ -112,7 +112,11 @@ _WorkflowDumper.add_representer(
     lambda dumper, text: dumper.represent_scalar("tag:yaml.org,2002:str", text, style="|" if "\n" in text else None),
 )
 
-ACTIONS = {"checkout": "actions/checkout@v6", "setup-python": "actions/setup-python@v6"}
+ACTIONS = {
+    "checkout": "actions/checkout@v6",
+    "setup-python": "actions/setup-python@v6",
+    "upload-artifact": "actions/upload-artifact@v7",
+}
 CHECKED = "grader-check.txt"  # the check's lines, for the summary (in the runner's workspace)
 
 CHOOSE_GRADER = """\
@@ -150,8 +154,8 @@ mkdir -p results"""
 
 GRADE = """\
 set -o pipefail
-python -m grading grade ../submission --require-isolation --results ../results/results.json \\
-  | tee ../results/marks.txt"""
+python -m grading grade ../submission --require-isolation ${ASSIGNMENT:+--assignment "$ASSIGNMENT"} \\
+  --results ../results/results.json | tee ../results/marks.txt"""
 
 SUMMARY = f"""\
 {{
@@ -168,9 +172,9 @@ SUMMARY = f"""\
            "was compared with nothing the student cannot rewrite: compare that digest with the course's."
     fi
     echo
-    echo '```'
-    cat results/marks.txt
-    echo '```'
+    # The results' own Markdown (the marks per function and what each mistake is), as Gradescope shows it.
+    python3 -c 'import json; print(json.load(open("results/results.json"))["output"])' 2> /dev/null \
+      || {{ echo '```'; cat results/marks.txt; echo '```'; }}
   elif [ "$COURSE" = failure ]; then
     echo "Grading did not run: the course repository $COURSE_REPOSITORY could not be checked out at" \\
          "$COURSE_REF. If it is private, the instructor adds a read-only token as the secret" \\
@@ -222,7 +226,20 @@ def _student_workflow(course_repository, digest, course_ref=None):
     source = "steps.grader.outputs.source"
     workflow = {
         "name": "Advisory check",
-        "on": {"push": None, "workflow_dispatch": None},
+        # A push that changes pcl_course/ (not every push: large classes), any tag, or by hand.
+        "on": {
+            "push": {"branches": ["**"], "tags": ["**"], "paths": ["pcl_course/**"]},
+            "workflow_dispatch": {
+                "inputs": {
+                    "assignment": {
+                        "description": f"the lecture to grade ({', '.join(sorted(ASSIGNMENTS))}; empty: every one)",
+                        "required": False,
+                        "default": "",
+                        "type": "string",
+                    }
+                }
+            },
+        },
         "permissions": {"contents": "read"},
         "jobs": {
             "check": {
@@ -232,6 +249,8 @@ def _student_workflow(course_repository, digest, course_ref=None):
                     "COURSE_REPOSITORY": repository,
                     "COURSE_REF": f"${{{{ vars.PCL_COURSE_REF || '{course_ref or course_tag(digest)}' }}}}",
                     "GRADER_DIGEST": digest,
+                    # The lecture graded: the run's input, else the repository variable, else every one.
+                    "ASSIGNMENT": "${{ inputs.assignment || vars.PCL_ASSIGNMENT }}",
                 },
                 "steps": [
                     {
@@ -292,6 +311,12 @@ def _student_workflow(course_repository, digest, course_ref=None):
                             "GRADE": "${{ steps.grade.outcome }}",
                         },
                         "run": SUMMARY,
+                    },
+                    {
+                        "name": "Keep results.json as an artifact of the run",
+                        "if": "always()",
+                        "uses": ACTIONS["upload-artifact"],
+                        "with": {"name": "results", "path": "results/", "if-no-files-found": "ignore"},
                     },
                 ],
             }

@@ -327,9 +327,10 @@ def test_the_students_submission_never_becomes_the_graders_stubs(release_dir, co
 def test_the_workflow_summary_says_why_grading_did_not_run(release_dir, tmp_path, outcomes, expected):
     steps = workflow_steps((release_dir / ".github" / "workflows" / "check.yml").read_text())
     summary = next(step for step in steps.values() if "GITHUB_STEP_SUMMARY" in step.get("run", ""))
-    if outcomes["GRADE"] == "success":
+    if outcomes["GRADE"] == "success":  # the results' Markdown is the summary (issue 37, item 3)
         (tmp_path / "results").mkdir()
-        (tmp_path / "results" / "marks.txt").write_text("Total: 1 / 2\n")
+        (tmp_path / "results" / "marks.txt").write_text("a fenced table\n")
+        (tmp_path / "results" / "results.json").write_text(json.dumps({"output": "**Total: 1 / 2**"}))
     if "failure" in (outcomes.get("HASHES"), outcomes.get("COMPARE")):
         (tmp_path / "grader-check.txt").write_text("::error::...\ngrading/mistakes.py is a symbolic link\n")
     env = {"COURSE": "", "COMPARE": "", "HASHES": "", "COURSE_REPOSITORY": "a/b", "COURSE_REF": "grader-x"}
@@ -446,3 +447,52 @@ def test_the_student_makefile_shares_the_set_up_rules(release_dir):
     for target in ("setup", "book", "test"):
         completed = subprocess.run(["make", "-n", target], cwd=release_dir, capture_output=True, text=True)
         assert completed.returncode == 0, completed.stderr
+
+
+def test_the_workflow_runs_on_changes_to_the_exercises_tags_or_by_hand_and_keeps_its_results(release_dir):
+    """Issue 37, item 3: not every push (large classes), any tag, or by hand with a lecture to grade; the
+    lecture also from the repository variable PCL_ASSIGNMENT; results.json kept as an artifact."""
+    workflow = yaml.safe_load((release_dir / ".github" / "workflows" / "check.yml").read_text())
+    triggers = workflow.get("on", workflow.get(True))  # YAML 1.1 reads a bare `on` as True
+    assert triggers["push"] == {"branches": ["**"], "tags": ["**"], "paths": ["pcl_course/**"]}
+    assert triggers["workflow_dispatch"]["inputs"]["assignment"]["default"] == ""
+    assert workflow["jobs"]["check"]["env"]["ASSIGNMENT"] == "${{ inputs.assignment || vars.PCL_ASSIGNMENT }}"
+    upload = [s for s in workflow["jobs"]["check"]["steps"] if s.get("uses", "").startswith("actions/upload-artifact")]
+    assert upload and upload[0]["if"] == "always()" and upload[0]["with"]["path"] == "results/"
+
+
+@pytest.mark.parametrize("assignment, expected", [("lecture2", "--assignment lecture2"), ("", "")])
+def test_the_workflow_grades_the_lecture_it_is_given(release_dir, tmp_path, assignment, expected):
+    steps = workflow_steps((release_dir / ".github" / "workflows" / "check.yml").read_text())
+    fake = tmp_path / "bin" / "python"  # records what the grade step asks of the grader
+    fake.parent.mkdir()
+    fake.write_text('#!/bin/sh\necho "$@"\n')
+    fake.chmod(0o755)
+    (tmp_path / "course").mkdir()
+    (tmp_path / "results").mkdir()
+    env = {"ASSIGNMENT": assignment, "PATH": f"{fake.parent}:{os.environ['PATH']}"}
+    completed = run_step(steps["grade"], tmp_path / "course", env)
+    assert completed.returncode == 0, completed.stderr
+    arguments = (tmp_path / "results" / "marks.txt").read_text()
+    assert arguments.startswith("-m grading grade ../submission --require-isolation ")
+    assert (expected in arguments) if expected else "--assignment" not in arguments
+
+
+def test_the_summary_falls_back_to_the_table_without_a_results_file(release_dir, tmp_path):
+    steps = workflow_steps((release_dir / ".github" / "workflows" / "check.yml").read_text())
+    summary = next(step for step in steps.values() if "GITHUB_STEP_SUMMARY" in step.get("run", ""))
+    (tmp_path / "results").mkdir()
+    (tmp_path / "results" / "marks.txt").write_text("Total: 1 / 2\n")
+    env = {"SOURCE": "hashes", "HASHES": "success", "SETUP": "success", "GRADE": "success", "GRADER_DIGEST": "0"}
+    env = {**env, "COURSE": "", "COMPARE": "", "GITHUB_STEP_SUMMARY": str(tmp_path / "summary.md")}
+    assert run_step(summary, tmp_path, env).returncode == 0
+    assert "```\nTotal: 1 / 2\n```" in (tmp_path / "summary.md").read_text()
+
+
+def test_the_student_makefile_grades_one_lecture_when_asked(release_dir):
+    completed = subprocess.run(
+        ["make", "-n", "test", "ASSIGNMENT=lecture2"], cwd=release_dir, capture_output=True, text=True
+    )
+    assert "grade . --assignment lecture2 --results" in completed.stdout, completed.stdout
+    completed = subprocess.run(["make", "-n", "test"], cwd=release_dir, capture_output=True, text=True)
+    assert "grade .  --results" in completed.stdout or "grade . --results" in completed.stdout, completed.stdout
