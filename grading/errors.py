@@ -85,6 +85,10 @@ class StudentError(Exception):
     """The implementation under test raised an unexpected exception."""
 
 
+# Why a package is forbidden in lecture 1's exercise modules (the grader's message, and ruff's in a release).
+VISUALISATION_ONLY = "Open3D, PCL and scikit-learn are allowed for visualisation only, outside the exercise modules"
+
+
 class ForbiddenAPI(Exception):
     """An exercise module uses (or imports a module that uses) a forbidden API."""
 
@@ -93,7 +97,7 @@ class ForbiddenAPI(Exception):
         if module in FORBIDDEN_IN_MODULE:
             why = "this lecture is about writing the search: no library's neighbour search, nor pcl_course.neighbors"
         else:
-            why = "Open3D, PCL and scikit-learn are allowed for visualisation only, outside the exercise modules"
+            why = VISUALISATION_ONLY
         super().__init__(f"forbidden API in {module}.py ({shown}): write your own code; {why}")
 
 

@@ -9,6 +9,7 @@ import re
 import shutil
 import subprocess
 import sys
+import tomllib
 
 import pytest
 import yaml
@@ -138,7 +139,7 @@ def test_the_workflow_grades_with_a_pristine_grader_in_the_sandbox(release_dir):
     assert env["COURSE_REF"] == f"${{{{ vars.PCL_COURSE_REF || 'grader-{digest[:12]}' }}}}"
     steps = workflow_steps(text)
     uses = {step["uses"].split("@")[0]: step["uses"].split("@")[1] for step in steps.values() if "uses" in step}
-    assert uses == {"actions/checkout": "v6", "actions/setup-python": "v6"}
+    assert uses == {"actions/checkout": "v6", "actions/setup-python": "v6", "actions/upload-artifact": "v7"}
     # A private course repository is read with the instructors' token, at the release's tag.
     assert steps["course"]["with"]["token"] == "${{ secrets.PCL_COURSE_TOKEN || github.token }}"
     assert steps["course"]["with"]["ref"] == "${{ env.COURSE_REF }}"
@@ -496,3 +497,28 @@ def test_the_student_makefile_grades_one_lecture_when_asked(release_dir):
     assert "grade . --assignment lecture2 --results" in completed.stdout, completed.stdout
     completed = subprocess.run(["make", "-n", "test"], cwd=release_dir, capture_output=True, text=True)
     assert "grade .  --results" in completed.stdout or "grade . --results" in completed.stdout, completed.stdout
+
+
+def test_ruff_flags_a_forbidden_import_in_an_exercise_module_as_the_grader_words_it(release_dir, tmp_path):
+    """Issue 37, item 4: the student pyproject.toml's banned-api rules come from grading/config.py, in the
+    exercise modules only (the helpers may use Open3D), with the grader's own message."""
+    from grading.config import FORBIDDEN_PACKAGES
+    from grading.errors import VISUALISATION_ONLY
+
+    copy = tmp_path / "repo"
+    shutil.copytree(release_dir, copy, ignore=PRISTINE_COPY)
+    pca = copy / "pcl_course" / "pca.py"
+    pca.write_text("import open3d\nfrom sklearn.decomposition import PCA\n" + pca.read_text())
+    (copy / "pcl_course" / "plotting.py").write_text(
+        "import open3d\n" + (copy / "pcl_course" / "plotting.py").read_text()
+    )
+    ruff = [str(REPO_ROOT / ".venv" / "bin" / "ruff"), "check", "--no-cache", "--output-format", "concise", "."]
+    completed = subprocess.run(ruff, cwd=copy, capture_output=True, text=True, timeout=STEP_BACKSTOP)
+    flagged = [line for line in completed.stdout.splitlines() if "TID251" in line]
+    assert [line.split(":")[0] for line in flagged] == ["pcl_course/pca.py"] * 2, completed.stdout
+    assert all(VISUALISATION_ONLY in line for line in flagged)
+    banned = tomllib.loads((copy / "pyproject.toml").read_text())["tool"]["ruff"]["lint"]["flake8-tidy-imports"]
+    assert set(banned["banned-api"]) == set(FORBIDDEN_PACKAGES)
+    pca.write_text(pca.read_text().split("\n", 2)[2])  # the released modules themselves pass
+    completed = subprocess.run(ruff, cwd=copy, capture_output=True, text=True, timeout=STEP_BACKSTOP)
+    assert "TID251" not in completed.stdout, completed.stdout
