@@ -7,7 +7,8 @@ Exercise modules (implement the stubs), by lecture:
 - lecture 2, nearest neighbours: :mod:`nn`.
 
 Complete helpers (use them): :mod:`validation`, :mod:`datasets`, :mod:`io`,
-:mod:`neighbors`, :mod:`plotting`, :mod:`book`.
+:mod:`neighbors`, :mod:`plotting`, :mod:`book`; :func:`check` grades an
+exercise from a notebook cell (:mod:`checking`).
 """
 
 import os as _os
@@ -15,3 +16,5 @@ import os as _os
 # Open3D starts a WebRTC visualiser (and prints about it) when imported in
 # Jupyter; the book draws with matplotlib and Plotly and needs neither.
 _os.environ.setdefault("OPEN3D_DISABLE_WEB_VISUALIZER", "true")
+
+from pcl_course.checking import check as check  # noqa: E402  (check("pca") in a notebook cell)
