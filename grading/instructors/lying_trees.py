@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from grading.instructors.trees import DECOY_FRACTION, bst_reach, squared_distances
+from grading.instructors.trees import bst_reach, decoy_places, squared_distances
 
 __all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps", "counter_decoys", "bst_own_swap"]
 
@@ -22,8 +22,8 @@ __all__ = ["decoy_points", "leaf_walk", "trap_swaps", "bst_trap_swaps", "counter
 # -- lying trees ----------------------------------------------------------------------------------
 
 
-def decoy_points(points, tree, reached, query, nearest, rng, radius=None):
-    """``points`` with one point of every unreached node moved next to ``query``.
+def decoy_points(points, tree, reached, query, within, rng):
+    """``points`` with one point of every unreached leaf moved near ``query``, at random in the ball of ``within``.
 
     Parameters
     ----------
@@ -33,37 +33,33 @@ def decoy_points(points, tree, reached, query, nearest, rng, radius=None):
     reached : set of int
         The nodes the rule reads (:func:`kdtree_reach`, :func:`octree_reach`).
     query : ndarray, shape (D,)
-    nearest : float
-        The true nearest distance (> 0): decoys land well inside it.
+    within : float
+        The true k-th distance, or the radius (> 0): the decoys land inside
+        it (:func:`grading.instructors.trees.decoy_places`), so a search
+        that reads one returns it, and spread as real points are.
     rng : numpy.random.Generator
-    radius : float, optional
-        For a radius search: decoys land inside it as well.
 
     Returns
     -------
     moved : ndarray, shape (N, D)
-        The lying cloud (every other point unchanged).
+        The lying cloud (every other point unchanged; an octree's decoys move in xyz).
     decoys : ndarray of int64
         The moved points' indices.
     """
-    leaves = _leaves(tree)
     covered = np.zeros(len(tree["order"]), dtype=bool)
     for node in reached:
         covered[tree["start"][node] : tree["stop"][node]] = True
     free = np.flatnonzero(~covered)  # the positions in ``order`` no reached node lists
+    starts = np.array([tree["start"][leaf] for leaf in _leaves(tree)], dtype=np.int64)
+    stops = np.array([tree["stop"][leaf] for leaf in _leaves(tree)], dtype=np.int64)
+    first = np.searchsorted(free, starts)  # each leaf's first free position, if any
+    has = first < len(free)
+    has[has] = free[first[has]] < stops[has]
+    decoys = np.asarray(tree["order"], dtype=np.int64)[free[first[has]]]
     moved = np.array(points, dtype=float)
-    decoys = []
-    scale = DECOY_FRACTION * min(nearest, radius if radius else math.inf)
-    for leaf in leaves:
-        first = np.searchsorted(free, tree["start"][leaf])  # the leaf's first free position, if any
-        if first == len(free) or free[first] >= tree["stop"][leaf]:
-            continue
-        index = int(tree["order"][free[first]])
-        direction = rng.standard_normal(moved.shape[1])
-        direction /= np.linalg.norm(direction)
-        moved[index] = query + direction * scale * (1 + len(decoys) / (2 * len(leaves)))
-        decoys.append(index)
-    return moved, np.array(decoys, dtype=np.int64)
+    width = moved.shape[1] if "axis" in tree else 3
+    moved[decoys, :width] = decoy_places(np.asarray(query, dtype=float)[:width], within, len(decoys), rng)
+    return moved, decoys
 
 
 def _leaves(tree):
@@ -383,9 +379,9 @@ def bst_own_swap(keys, left, right, query, k, partner="unreached", margin=TRAP_M
 
     Every key a BST search reads steers it, but for those of childless
     nodes: those can move without changing where a search goes. C's
-    interval holds the query, so the structure test's decoys (every key the
-    rule never reaches, moved next to the query) lie in it, and a swap
-    through C is what makes a misplacement mutual:
+    interval holds the query and every value between the query and its
+    nearest key, so a decoy placed there lies in it, and a swap through C is
+    what makes such a decoy's misplacement mutual:
 
     - ``partner="unreached"``, a counter-decoy (the BST's form of
       :func:`counter_decoys`): U is a childless node the rule never reaches.
@@ -469,7 +465,7 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
     """``moved`` with a partner for some decoys: a point of the query's leaf moved into the decoy's leaf.
 
     A decoy d is listed under a leaf U that the rule never reaches and lies
-    next to the query, in the query's own leaf Y (read by every search). A
+    near the query; some lie in the query's own leaf Y (read by every search). A
     counter-decoy c is a point listed under Y, moved into U's cell (to d's
     vacated place, or halfway from it to another point of U): now d and c are
     listed each under the other's leaf, a swap as mutual as a trap's, so a
@@ -545,7 +541,7 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
     candidates.sort(key=lambda i: (-s[i], i))  # the farthest first: room for a place in U nearer than it
     decoys = np.asarray(decoys, dtype=np.int64)
     placed = result[decoys, :width]
-    clear = np.min(np.minimum(placed - y_lower, y_upper - placed), axis=1) > clearance * DECOY_FRACTION
+    clear = np.min(np.minimum(placed - y_lower, y_upper - placed), axis=1) > clearance
     clear = [int(d) for d in decoys[clear]]  # the decoys that lie clearly in Y
     # _box_gap_squared, every leaf at once
     gaps = np.sum((np.maximum(lowers - query, 0.0) + np.maximum(query - uppers, 0.0)) ** 2, axis=1)

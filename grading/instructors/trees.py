@@ -9,8 +9,10 @@ from this module.
 
 **Decoy trees** (the book's chapter on k-d trees proves why they are fair):
 run the contract's search on one query and record the nodes it reaches;
-then move one point of every node it does not reach next to the query. The
-tree still says those points are where they were. A search that follows the
+then move one point of every node it does not reach to a random place within
+the k-th distance (or the radius) of the query, spread as real points are
+(:func:`decoy_places`; a tight core around the query let a brute force that
+dropped it pass). The tree still says those points are where they were. A search that follows the
 rule, or prunes more, never reads them and returns the true answer; one that
 reads an unreached node (brute force, a library, no pruning, the far side
 first, a too-weak test) returns a decoy.
@@ -58,8 +60,8 @@ trap and dropped every decoy (issue 35's hostile review, hole 5). So some
 decoys get a partner: a point c listed under Y, moved into U's cell (to the
 decoy's vacated place, or halfway from it to another point of U, well inside
 U's cell). Now d and c are listed each under the other's leaf, as a trap's
-two points are, and that search keeps d, which lies next to the query, and
-returns it. c's true and new places both lie beyond the k-th distance (or the
+two points are, and that search keeps d, which lies within the k-th distance,
+and returns it. c's true and new places both lie beyond the k-th distance (or the
 radius), with margin; for kNN its new place is strictly nearer the query than
 its true one. Every lawful search still answers right:
 
@@ -106,11 +108,38 @@ __all__ = [
     "octree_reach",
     "brute_knn",
     "brute_radius",
+    "decoy_places",
 ]
 
-# Decoys sit this far from the query, as a fraction of the true nearest distance,
-# each at its own distance so that their order is defined.
-DECOY_FRACTION = 1e-3
+# Decoys land at random in the ball of the k-th distance (or the radius) around the query, shrunk by
+# this fraction: nearer than the answer's farthest point, so that a search that reads one returns it,
+# and spread as real points are, so that no distance alone tells them apart (a tight cluster did).
+DECOY_MARGIN = 1e-3
+
+
+def decoy_places(query, within, count, rng):
+    """``count`` places drawn uniformly in the ball of radius ``within * (1 - DECOY_MARGIN)`` around ``query``.
+
+    Parameters
+    ----------
+    query : array_like, shape (D,)
+        A 1-element query for a BST's keys.
+    within : float
+        The k-th distance or the radius (> 0).
+    count : int
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    ndarray, shape (count, D)
+    """
+    query = np.atleast_1d(np.asarray(query, dtype=float))
+    if not within > 0:
+        raise ValueError(f"within must be > 0 (decoys need room nearer than the answer), got {within}")
+    directions = rng.standard_normal((count, len(query)))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    radii = within * (1 - DECOY_MARGIN) * rng.uniform(size=count) ** (1 / len(query))
+    return query + directions * radii[:, None]
 
 
 # -- brute force (the expected answers) ----------------------------------------------------------

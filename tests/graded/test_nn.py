@@ -106,16 +106,21 @@ def two_clusters(n, seed, dim=3):
     return np.vstack([cube(n, seed, dim), cube(n, seed + 1, dim) + np.eye(dim)[0] * 100.0])
 
 
-def with_decoys(points, far, query):
-    """The cloud as a lying tree shows it: the points ``far`` moved next to the query, nearer than any other,
-    while the tree still lists them where they were. A search that follows the rule never reads them; one
-    that reads every point (brute force, a library, no pruning) returns them. The hidden structure tests
-    plant such decoys in every node the rule does not reach, on other data."""
+def with_decoys(points, far, query, k):
+    """The cloud as a lying tree shows it: the points ``far`` moved near the query, at random within the
+    k-th distance of the others, while the tree still lists them where they were. A search that follows the
+    rule never reads them; one that reads every point (brute force, a library, no pruning) returns them.
+    The hidden structure tests plant such decoys in every node the rule does not reach, on other data."""
     lying = np.array(points, dtype=float)
+    rows = lying.reshape(len(lying), -1)
+    query = np.atleast_1d(query)
     others = np.setdiff1d(np.arange(len(lying)), far)
-    nearest = np.sqrt(np.min(squared(lying[others].reshape(len(others), -1), np.atleast_1d(query))))
-    offsets = nearest * 1e-3 * (1.0 + np.arange(len(far)) / len(far))
-    lying[far] = np.atleast_1d(query) + (offsets[:, None] if lying.ndim == 2 else offsets)
+    within = np.sqrt(np.sort(squared(rows[others], query))[k - 1]) * (1 - 1e-3)
+    rng = np.random.default_rng(len(far) + k)
+    directions = rng.standard_normal((len(far), len(query)))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    places = query + directions * (within * rng.uniform(size=len(far)) ** (1 / len(query)))[:, None]
+    lying[far] = places if lying.ndim == 2 else places[:, 0]
     return lying
 
 
@@ -125,8 +130,9 @@ def check_no_decoy(indices, far, what):
     if len(read):
         raise CheckFailed(
             f"{what} returned point {read[0]} of the far cluster, which its rule never reaches for this query; "
-            "its coordinates were moved next to the query, and a search that follows the rule never reads "
-            "them: yours reads points its rule does not reach (brute force, a library, no pruning)",
+            "the cluster's points were moved nearer the query than its k-th true neighbour, and a search that "
+            "follows the rule never reads them: yours reads points its rule does not reach (brute force, a library, "
+            "no pruning)",
             rule=f"{what} reads nodes its rule does not reach",
         )
 
@@ -337,7 +343,7 @@ def test_bst_knn_never_reads_a_subtree_its_rule_skips(impl):
     left, right = bst_of(impl, keys)
     far = np.arange(300, 600)
     for query, k in ((-0.8, 1), (-0.35, 4), (0.0, 9)):
-        indices, distances = impl.bst_knn(with_decoys(keys, far, query), left, right, query, k)
+        indices, distances = impl.bst_knn(with_decoys(keys, far, query, k), left, right, query, k)
         check_array(indices, "indices", shape=(k,), dtype="int64")
         check_no_decoy(indices, far, "bst_knn")
         expected = np.lexsort((np.arange(300), np.abs(keys[:300] - query)))[:k]
@@ -463,7 +469,7 @@ def test_kdtree_knn_never_reads_a_cluster_its_rule_skips(impl):
     tree = kd_tree(impl, points, 8)
     far = np.arange(300, 600)
     for query in cube(4, 40) * 0.7:
-        indices, distances = impl.kdtree_knn(tree, with_decoys(points, far, query), query[None], 6)
+        indices, distances = impl.kdtree_knn(tree, with_decoys(points, far, query, 6), query[None], 6)
         check_array(indices, "indices", shape=(1, 6), dtype="int64")
         check_no_decoy(indices, far, "kdtree_knn")
         check_knn(indices, distances, *brute_knn(points[:300], query[None], 6), "kdtree_knn")
@@ -680,7 +686,7 @@ def test_octree_knn_never_reads_a_cluster_its_rule_skips(impl):
     tree = oc_tree(impl, points, 8)
     far = np.arange(300, 600)
     for query in cube(4, 80) * 0.7:
-        indices, distances = impl.octree_knn(tree, with_decoys(points, far, query), query[None], 6)
+        indices, distances = impl.octree_knn(tree, with_decoys(points, far, query, 6), query[None], 6)
         check_array(indices, "indices", shape=(1, 6), dtype="int64")
         check_no_decoy(indices, far, "octree_knn")
         check_knn(indices, distances, *brute_knn(points[:300], query[None], 6), "octree_knn")

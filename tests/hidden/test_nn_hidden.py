@@ -2,7 +2,8 @@
 
 Each structure test hands the submission a tree built by the grader
 (``grading/instructors/trees.py``) whose unreached nodes lie: one point of every node
-the contract's rule does not reach is moved next to the query. A search
+the contract's rule does not reach is moved near the query, at random within
+the k-th distance or the radius (so no distance alone tells it). A search
 that follows the rule, or prunes more, never reads them and returns the
 brute-force answer of the original cloud; a search that reads more
 (brute force, a library, no pruning, the far side first, a too-weak test)
@@ -148,8 +149,8 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
             reached, margin = trees.bst_reach(true_keys, left, right, query, k)
             if margin < MARGIN:
                 continue
-            gaps = np.abs(true_keys - query)
-            nearest = np.min(gaps[gaps > 0])  # the decoys lie nearer than any other key, the query's own apart
+            gaps = np.sort(np.abs(true_keys - query))
+            nearest = np.min(gaps[gaps > 0])
             trapped_keys, trapped = lying_trees.bst_trap_swaps(true_keys, left, right, query, k)
             traps += len(trapped) // 2
             unreached = np.setdiff1d(np.arange(len(keys)), sorted(reached))
@@ -159,8 +160,10 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
             elif pair is not None:
                 counters += 1  # U's ancestors keep their keys: U's interval is the true tree's
                 unreached = np.setdiff1d(unreached, lying_trees.bst_descent(keys, left, right, keys[pair[1]])[:-1])
-            lying = trapped_keys.copy()
-            lying[unreached] = query + nearest * 1e-3 * (1 + np.arange(len(unreached)) / len(unreached))
+            lying = trapped_keys.copy()  # the decoys: spread in the k-th distance, as the keys are
+            lying[unreached] = trees.decoy_places(query, gaps[k - 1] or nearest, len(unreached), rng)[:, 0]
+            if pair is not None and partner == "unreached":  # U's decoy lies in C's interval: between the query
+                lying[pair[1]] = query + nearest * rng.uniform(0.01, 0.99)  # and the nearest key above or below
             indices, _ = impl.bst_knn(lying, left, right, float(query), k)
             expected = np.lexsort((np.arange(len(keys)), np.abs(trapped_keys - query)))[:k]
             if as_list(indices, k) != expected.tolist():
@@ -204,6 +207,13 @@ def onto_a_split_plane(tree):
     return move
 
 
+def answer_reach(points, query, k=None, radius=None):
+    """The distance within which the decoys land: the true k-th distance, or the radius."""
+    if radius is not None:
+        return radius
+    return float(np.sqrt(np.sort(trees.squared_distances(points[:, : len(query)], query))[k - 1]))
+
+
 def kd_decoy_case(points, leaf_size, seed, k=None, radius=None, on_planes=False):
     """Per fair query: the lying tree (traps swapped in), the lying cloud (decoys moved), decoys and traps;
     ``on_planes``: the queries lie on split planes (:func:`onto_a_split_plane`)."""
@@ -212,8 +222,8 @@ def kd_decoy_case(points, leaf_size, seed, k=None, radius=None, on_planes=False)
     onto = onto_a_split_plane(tree) if on_planes else None
     reach = lambda q: trees.kdtree_reach(tree, points, q, k=k, radius=radius)  # noqa: E731
     for query, reached in fair_queries(points, seed, reach, onto=onto):
-        nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
-        lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
+        within = answer_reach(points, query, k, radius)
+        lying, decoys = lying_trees.decoy_points(points, tree, reached, query, within, rng)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
         lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
         lying, partnered, _ = lying_trees.counter_decoys(
@@ -332,8 +342,8 @@ def oc_decoy_case(points, leaf_size, seed, k=None, radius=None, on_planes=False)
 
     onto = onto_a_centre_plane(tree) if on_planes else None
     for query, reached in fair_queries(points, seed, reach, onto=onto):
-        nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
-        lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng, radius=radius)
+        within = answer_reach(points, query, k, radius)
+        lying, decoys = lying_trees.decoy_points(points, tree, reached, query, within, rng)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
         lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
         lying, partnered, _ = lying_trees.counter_decoys(
@@ -447,9 +457,8 @@ def test_octree_knn_hidden_ends_when_the_ball_is_inside_an_octant(impl):
         for below in subtree(tree, sibling):
             lying_tree["center"][below] = query  # it now "meets" every ball around the query
         lying_points = points.copy()
-        nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
         decoy = tree["order"][tree["start"][sibling]]
-        lying_points[decoy] = query + nearest * 1e-3
+        lying_points[decoy] = trees.decoy_places(query, answer_reach(points, query, k), 1, rng)[0]
         indices, distances = impl.octree_knn(lying_tree, lying_points, query[None], k)
         try:
             check_knn(indices, distances, *[a[None] for a in trees.brute_knn(points, query, k)], "octree_knn")

@@ -52,8 +52,8 @@ def test_a_lying_tree_keeps_the_rules_answer_and_fools_brute_force(rng):
         tree = build()
         for query in rng.uniform(0.1, 0.9, size=(5, 3)):
             reached = reach(tree, query)
-            nearest = np.sqrt(np.min(trees.squared_distances(points, query)))
-            lying, decoys = lying_trees.decoy_points(points, tree, reached, query, nearest, rng)
+            within = np.sqrt(np.sort(trees.squared_distances(points, query))[3])  # the 4th distance
+            lying, decoys = lying_trees.decoy_points(points, tree, reached, query, within, rng)
             assert len(decoys) > 10 * len(reached)
             original = trees.brute_knn(points, query, 4)[0]
             assert np.array_equal(search(tree, lying, query[None], 4)[0][0], original)  # the rule is not fooled
