@@ -152,3 +152,43 @@ def test_every_graded_exercise_links_its_stub():
             assert stubs, f"{page_name}: a graded exercise has no link to its stub"
             assert all((REPO_ROOT / "pcl_course" / stub).is_file() for stub in stubs)
     assert graded >= 10, f"found only {graded} graded exercises in the built book"
+
+
+def prose_text(html):
+    """A page's text outside code, scripts, styles and rendered math (where a ``$`` or a ``|`` belongs)."""
+    from html.parser import HTMLParser
+
+    class Text(HTMLParser):
+        SKIP = {"script", "style", "pre", "code", "table"}
+
+        def __init__(self):
+            super().__init__()
+            self.stack, self.depth, self.parts = [], 0, []
+
+        def handle_starttag(self, tag, attrs):
+            skip = tag in self.SKIP or "math" in (dict(attrs).get("class") or "").split()
+            self.stack.append(skip)
+            self.depth += skip
+
+        def handle_endtag(self, tag):
+            if self.stack:
+                self.depth -= self.stack.pop()
+
+        def handle_data(self, data):
+            if not self.depth:
+                self.parts.append(data)
+
+    parser = Text()
+    parser.feed(html)
+    return "".join(parser.parts)
+
+
+@pytest.mark.parametrize("name", toc_files())
+def test_math_and_tables_render_on_every_page(name):
+    """Issue 38: a ``$$`` opened mid-paragraph, a line starting ``+ `` inside math, or a cell's Markdown
+    read as CommonMark left raw TeX and tables as paragraphs of pipes on five pages."""
+    text = prose_text(page(name))
+    raw_math = [text[max(0, m.start() - 40) : m.start() + 40] for m in re.finditer(r"\$", text)]
+    assert not raw_math, f"{name}: a $ outside rendered math: {raw_math[:3]}"
+    pipes = [line for line in text.splitlines() if line.count("|") >= 3]
+    assert not pipes, f"{name}: a table left as text: {pipes[:2]}"
