@@ -36,7 +36,7 @@ def decoy_points(points, tree, reached, query, within, rng):
     within : float
         The true k-th distance, or the radius (> 0): the decoys land inside
         it (:func:`grading.instructors.trees.decoy_places`), so a search
-        that reads one returns it, and spread as real points are.
+        that reads one returns it, and uniformly in it, so that no distance alone tells them apart.
     rng : numpy.random.Generator
 
     Returns
@@ -193,6 +193,17 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
     pairs : int, default 2
         At most this many swaps.
 
+    kNN also gets one **reverse** pair where it can: A comes first in
+    depth-first order, but p lies strictly nearer the query than A's cell
+    (and B's cell, p's own, is nearer still). A search that reads every
+    point and drops those nearer the query than the cell that lists them
+    (no true point is; every decoy is) drops p. Every lawful search still
+    answers right: a depth-first one holds p earlier than on the true tree,
+    as above; best-bin-first reads the leaves in cell-distance order, so
+    before A it reads only leaves nearer than A, all within the k-th
+    distance and reached by the rule, and from A on it holds what it holds
+    on the true tree.
+
     Returns
     -------
     lying : dict
@@ -202,6 +213,8 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
     own_leaf_kept : bool
         Whether some swap leaves both of its leaves apart from the query's
         own leaf (a search that filters all but its own leaf fails it).
+    reverse : bool
+        Whether a reverse pair was swapped (the first pair of ``swapped``).
     """
     points = np.asarray(points, dtype=float)
     octree = "axis" not in tree
@@ -232,14 +245,17 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
         ]
         necessary.append((position, leaf, gap2, lower, upper, slots))
     order = np.array(tree["order"], dtype=np.int64)
-    used, swapped, apart = set(), [], False
-    for attempt in range(2 * pairs):
-        if len(swapped) == 2 * pairs:
+    used, swapped, apart, reverse = set(), [], False, False
+    # The reverse pair first (kNN), so that the others do not take the leaves it needs.
+    attempts = ([(False, True)] if k is not None else []) + [(attempt == 0, False) for attempt in range(2 * pairs)]
+    for avoid_own, backwards in attempts:
+        if len(swapped) >= 2 * pairs + 2 * reverse:
             break
-        avoid_own = attempt == 0
-        found = _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, used | (own if avoid_own else set()))
+        excluded = used | (own if avoid_own else set())
+        found = _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, excluded, reverse=backwards)
         if found is None:
             continue
+        reverse = reverse or backwards
         (a_leaf, a_slot), (b_leaf, b_slot) = found
         used |= {a_leaf, b_leaf}
         apart = apart or not ({a_leaf, b_leaf} & own)
@@ -250,11 +266,12 @@ def trap_swaps(tree, points, query, k=None, radius=None, pairs=2):
             order[first : slot + 1] = np.roll(order[first : slot + 1], 1)
     lying = {key: np.array(value, copy=True) for key, value in tree.items()}
     lying["order"] = order
-    return lying, np.array(swapped, dtype=np.int64), apart
+    return lying, np.array(swapped, dtype=np.int64), apart, reverse
 
 
-def _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, excluded):
-    """Two slots ``(leaf, position in order)`` to swap (see :func:`trap_swaps`), or None if there are none.
+def _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, excluded, reverse=False):
+    """Two slots ``(leaf, position in order)`` to swap (see :func:`trap_swaps`), or None if there are none;
+    ``reverse``: a kNN pair whose p lies strictly nearer the query than A's cell.
 
     Of the pairs that qualify, the one whose two points end farthest outside
     their new cells, so that a filter with a tolerance drops them too.
@@ -271,6 +288,10 @@ def _trap_pair(necessary, order, xyz, s, in_answer, bound2, k, excluded):
                 continue
             if k is None:  # radius: u of B anywhere
                 b_points = b_slots
+            elif reverse:  # kNN, reverse: A before B, p of B in the answer and strictly nearer than A's cell
+                if b_position <= a_position:
+                    continue
+                b_points = [p for p in b_slots if in_answer[order[p]] and s[order[p]] < a_gap2 * (1 - TRAP_MARGIN)]
             elif b_position <= a_position or a_gap2 >= b_gap2 * (1 - TRAP_MARGIN):
                 continue
             else:  # kNN: p of B in the answer, A before B and nearer

@@ -10,7 +10,7 @@ from this module.
 **Decoy trees** (the book's chapter on k-d trees proves why they are fair):
 run the contract's search on one query and record the nodes it reaches;
 then move one point of every node it does not reach to a random place within
-the k-th distance (or the radius) of the query, spread as real points are
+the k-th distance (or the radius) of the query, uniformly in that ball
 (:func:`decoy_places`; a tight core around the query let a brute force that
 dropped it pass). The tree still says those points are where they were. A search that follows the
 rule, or prunes more, never reads them and returns the true answer; one that
@@ -113,7 +113,7 @@ __all__ = [
 
 # Decoys land at random in the ball of the k-th distance (or the radius) around the query, shrunk by
 # this fraction: nearer than the answer's farthest point, so that a search that reads one returns it,
-# and spread as real points are, so that no distance alone tells them apart (a tight cluster did).
+# and uniformly in that ball, so that no distance alone tells them apart (a tight cluster did).
 DECOY_MARGIN = 1e-3
 
 

@@ -225,27 +225,29 @@ def kd_decoy_case(points, leaf_size, seed, k=None, radius=None, on_planes=False)
         within = answer_reach(points, query, k, radius)
         lying, decoys = lying_trees.decoy_points(points, tree, reached, query, within, rng)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
+        lying_tree, trapped, apart, reverse = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
         lying, partnered, _ = lying_trees.counter_decoys(
             tree, lying_tree, points, lying, decoys, query, k=k, radius=radius, swapped=trapped
         )
-        yield lying_tree, query, lying, decoys, Traps(trapped, apart, len(partnered))
+        yield lying_tree, query, lying, decoys, Traps(trapped, apart, len(partnered), reverse)
 
 
 class Traps:
     """The swapped points of one query, whether a swap keeps clear of the query's own leaf, and how many
     decoys have a partner (:func:`grading.instructors.lying_trees.counter_decoys`)."""
 
-    def __init__(self, points, apart, partnered=0):
-        self.points, self.apart, self.partnered = points, apart, partnered
+    def __init__(self, points, apart, partnered=0, reverse=False):
+        self.points, self.apart, self.partnered, self.reverse = points, apart, partnered, reverse
 
     @staticmethod
-    def count(cases):
-        """Check that a test's queries planted traps, enough to fail a filter that spares its own leaf, and
-        decoys with a partner, enough to fail a filter that keeps the points swapped both ways."""
+    def count(cases, knn=False):
+        """Check that a test's queries planted traps, enough to fail a filter that spares its own leaf,
+        decoys with a partner, enough to fail a filter that keeps the points swapped both ways, and for kNN
+        reverse traps, enough to fail a filter that drops the points nearer than the cell that lists them."""
         pairs = sum(len(case.points) // 2 for case in cases)
         assert pairs >= 2 and any(case.apart for case in cases), "the test needs traps on its queries"
         assert sum(case.partnered for case in cases) >= 2, "the test needs decoys with a partner on its queries"
+        assert not knn or sum(case.reverse for case in cases) >= 2, "the test needs reverse traps on its queries"
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -264,7 +266,7 @@ def test_kdtree_knn_hidden_reads_only_what_its_rule_reaches(impl):
                 raise failure(
                     "kdtree_knn", indices, decoys, structure_failure("kdtree_knn"), expected[0], traps.points
                 ) from None
-    Traps.count(planted)
+    Traps.count(planted, knn=True)
 
 
 @pytest.mark.grades("kdtree_knn")
@@ -345,11 +347,11 @@ def oc_decoy_case(points, leaf_size, seed, k=None, radius=None, on_planes=False)
         within = answer_reach(points, query, k, radius)
         lying, decoys = lying_trees.decoy_points(points, tree, reached, query, within, rng)
         assert len(decoys) > len(reached), "the test needs most leaves unreached"
-        lying_tree, trapped, apart = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
+        lying_tree, trapped, apart, reverse = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
         lying, partnered, _ = lying_trees.counter_decoys(
             tree, lying_tree, points, lying, decoys, query, k=k, radius=radius, swapped=trapped
         )
-        yield lying_tree, query, lying, decoys, Traps(trapped, apart, len(partnered))
+        yield lying_tree, query, lying, decoys, Traps(trapped, apart, len(partnered), reverse)
 
 
 @pytest.mark.grades("octree_radius")
@@ -398,11 +400,19 @@ def test_octree_radius_hidden_reports_a_contained_octant_whole(impl):
         lying = {key: value.copy() for key, value in tree.items()}
         for below in subtree(tree, node)[1:]:
             lying["center"][below] = center + 1e3  # the children "are" far away: only the shortcut reports them
-        result = impl.octree_radius(lying, points, query[None], radius)
+        # One point of the octant moved beyond the ball: the shortcut reports it untested, with its distance
+        # (a search that tests each point's distance, as brute force does, drops it).
+        whole = tree["order"][tree["start"][node] : tree["stop"][node]]
+        moved, lying_points = int(rng.choice(whole)), points.copy()
+        lying_points[moved] = query + 1.5 * radius * np.eye(3)[rng.integers(3)]
+        rows, distances = trees.brute_radius(lying_points, query, radius)
+        beyond = np.sqrt(trees.squared_distances(lying_points[moved : moved + 1], query))
+        rows, distances = np.append(rows, moved), np.append(distances, beyond)
+        rank = np.lexsort((rows, distances))
+        result = impl.octree_radius(lying, lying_points, query[None], radius)
         try:
-            check_csr(result, [trees.brute_radius(points, query, radius)], "octree_radius")
+            check_csr(result, [(rows[rank], distances[rank])], "octree_radius")
         except CheckFailed:
-            whole = tree["order"][tree["start"][node] : tree["stop"][node]]
             if np.isin(whole, result[1]).all():  # the octant was reported whole: the fault is elsewhere
                 raise wrong_answer_failure("octree_radius") from None
             raise CheckFailed(
@@ -432,7 +442,7 @@ def test_octree_knn_hidden_reads_only_what_its_rule_reaches(impl):
                 raise failure(
                     "octree_knn", indices, decoys, structure_failure("octree_knn"), expected[0], traps.points
                 ) from None
-    Traps.count(planted)
+    Traps.count(planted, knn=True)
 
 
 @pytest.mark.grades("octree_knn")

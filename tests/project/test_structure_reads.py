@@ -200,6 +200,26 @@ def core_dropping_brute_force(function):
     return search
 
 
+def nearer_than_its_cell_dropped(tree, points, queries, k):
+    """Brute force that drops each point nearer the query than the cell of the leaf listing it (no true point
+    is, every decoy is: issue 35's third hostile review, which passed every k-d and octree kNN test). The
+    reverse traps list an answer point under a farther leaf, so this drops it."""
+    points, queries = np.asarray(points, dtype=float), np.asarray(queries, dtype=float)
+    width = points.shape[1] if "axis" in tree else 3
+    points, queries = points[:, :width], queries[:, :width]
+    rows = []
+    for query in queries:
+        gap2 = np.empty(len(points))
+        for leaf, lower, upper, _ in lying_trees.leaf_walk(tree, query):
+            listed = tree["order"][tree["start"][leaf] : tree["stop"][leaf]]
+            gap2[listed] = np.sum((np.maximum(lower - query, 0.0) + np.maximum(query - upper, 0.0)) ** 2)
+        s = trees.squared_distances(points, query)
+        kept = np.flatnonzero(s >= gap2)
+        rows.append(kept[np.lexsort((kept, s[kept]))][:k])
+    rows = np.array(rows, dtype=np.int64).reshape(len(queries), k)
+    return rows, np.sqrt(np.array([trees.squared_distances(points[r], q) for r, q in zip(rows, queries)]))
+
+
 READS = "reads nodes its rule does not reach"
 DROPS = "drops points of nodes it must read"
 DROPS_KEYS = "drops keys of nodes it must read"  # a BST's words
@@ -241,6 +261,11 @@ def cheats(function):
         "filter, own leaf kept (this file)": (
             functools.partial(getattr(_cell_filter, function), own_leaf=True),
             DROPS,
+        ),
+        **(
+            {"brute force without points nearer than their cell (this file)": (nearer_than_its_cell_dropped, DROPS)}
+            if function.endswith("knn")
+            else {}
         ),
     }
 
@@ -294,10 +319,11 @@ def test_on_a_trapped_tree_lawful_searches_read_within_their_reads_and_answer_ri
     tree = trees.kdtree(points, 6) if kind == "kdtree" else trees.octree(points, 6, 1e-3)
     searches = {name: search for name, search in lawful(f"{kind}_knn").items() if name != "reference"}
     radius_searches = {name: search for name, search in lawful(f"{kind}_radius").items() if name != "reference"}
-    planted = apart = partnered = 0
+    planted = apart = partnered = reversed_pairs = 0
     for query in rng.uniform(points.min(axis=0), points.max(axis=0), size=(40, 3)):
         for k, radius in ((int(rng.integers(1, 12)), None), (None, float(rng.uniform(0.03, 0.12)))):
-            lying, swapped, clear = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
+            lying, swapped, clear, reverse = lying_trees.trap_swaps(tree, points, query, k=k, radius=radius)
+            reversed_pairs += reverse
             planted += len(swapped) // 2
             apart += clear
             true_reads = reached_leaves(tree, points, query, k=k, radius=radius)
@@ -324,6 +350,7 @@ def test_on_a_trapped_tree_lawful_searches_read_within_their_reads_and_answer_ri
                 assert not np.isin(counters, expected).any()
     assert planted >= 40 and apart >= 20, f"too few traps planted ({planted}, {apart} apart from the own leaf)"
     assert partnered >= 5, f"too few decoys with a partner ({partnered})"
+    assert reversed_pairs >= 5, f"too few reverse traps ({reversed_pairs})"
 
 
 @pytest.mark.parametrize("partner", [None, "reached", "unreached"])
