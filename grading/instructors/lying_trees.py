@@ -482,6 +482,31 @@ def _depth_inside(point, lower, upper):
     return float(np.min(np.minimum(point - lower, upper - point)))
 
 
+_EVERY_LEAF = {"tree": None, "walk": None}  # the last tree's leaves: a structure test asks for one tree many times
+
+
+def _every_leaf(tree, width, n_points):
+    """Every leaf of ``tree``: :func:`leaf_walk`'s entries (in no particular order), the same as a dict by
+    leaf, the cells' lower and upper corners as arrays, and each point's leaf. The last tree's are kept,
+    since none of them depends on the query."""
+    if _EVERY_LEAF["tree"] is not tree:
+        walk = leaf_walk(tree, np.zeros(width))
+        listed = np.empty(n_points, dtype=np.int64)
+        for leaf, _, _, _ in walk:
+            listed[tree["order"][tree["start"][leaf] : tree["stop"][leaf]]] = leaf
+        _EVERY_LEAF.update(
+            tree=tree,
+            walk=(
+                walk,
+                {leaf: (lower, upper, path) for leaf, lower, upper, path in walk},
+                np.array([lower for _, lower, _, _ in walk]).reshape(len(walk), width),
+                np.array([upper for _, _, upper, _ in walk]).reshape(len(walk), width),
+                listed,
+            ),
+        )
+    return _EVERY_LEAF["walk"]
+
+
 def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radius=None, swapped=(), pairs=2):
     """``moved`` with a partner for some decoys: a point of the query's leaf moved into the decoy's leaf.
 
@@ -536,10 +561,7 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
     if bound2 <= 0:
         return result, np.empty(0, np.int64), np.empty(0, np.int64)
     clearance = SWAP_CLEARANCE * math.sqrt(bound2)
-    walk = leaf_walk(tree, query)
-    boxes = {leaf: (lower, upper, path) for leaf, lower, upper, path in walk}
-    lowers = np.array([lower for _, lower, _, _ in walk]).reshape(len(walk), width)
-    uppers = np.array([upper for _, _, upper, _ in walk]).reshape(len(walk), width)
+    walk, boxes, lowers, uppers, listed = _every_leaf(tree, width, len(points))
     depths = np.min(np.minimum(query - lowers, uppers - query), axis=1)  # _depth_inside, every leaf at once
     own = [leaf for (leaf, _, _, _), depth in zip(walk, depths) if depth > clearance]
     if len(own) != 1:
@@ -548,9 +570,6 @@ def counter_decoys(tree, lying_tree, points, moved, decoys, query, k=None, radiu
     y_lower, y_upper, y_path = boxes[y]
     if radius is not None and octree and _contained_on_path(tree, y_path, query, radius):
         return result, np.empty(0, np.int64), np.empty(0, np.int64)
-    listed = np.empty(len(points), dtype=np.int64)
-    for leaf in boxes:
-        listed[tree["order"][tree["start"][leaf] : tree["stop"][leaf]]] = leaf
     excluded = set(np.asarray(swapped, dtype=np.int64).tolist()) | set(np.asarray(decoys).tolist())
     candidates = [
         int(i)

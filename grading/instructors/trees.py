@@ -292,20 +292,21 @@ def octree(points, leaf_size, min_extent, root="bbox", plane="lower", linked=Tru
         node = len(nodes)
         nodes.append([len(order), None, center, extent, [-1] * 8])
         if len(indices) <= leaf_size or extent <= min_extent:
-            order.extend(sorted(indices))
+            order.extend(np.sort(indices).tolist())
         else:
-            codes = {}
-            for i in indices:
-                above = xyz[i] >= center if plane == "upper" else xyz[i] > center
-                codes.setdefault(int(sum(1 << j for j in range(3) if above[j])), []).append(i)
-            for code in sorted(codes):
+            # Each point's child code, all at once; a stable sort keeps each child's points in their order.
+            above = xyz[indices] >= center if plane == "upper" else xyz[indices] > center
+            codes = above @ np.array([1, 2, 4])
+            ranked = np.argsort(codes, kind="stable")
+            present, firsts = np.unique(codes[ranked], return_index=True)
+            for code, members in zip(present.tolist(), np.split(indices[ranked], firsts[1:])):
                 signs = np.array([1.0 if code >> j & 1 else -1.0 for j in range(3)])
-                child = grow(codes[code], center + signs * extent / 2, extent / 2)
+                child = grow(members, center + signs * extent / 2, extent / 2)
                 nodes[node][4][code] = child if linked else -1
         nodes[node][1] = len(order)
         return node
 
-    grow(list(range(len(xyz))), root_center, root_extent)
+    grow(np.arange(len(xyz)), root_center, root_extent)
     return {
         "order": np.array(order, dtype=np.int64),
         "start": np.array([n[0] for n in nodes], dtype=np.int64),
