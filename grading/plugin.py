@@ -180,10 +180,12 @@ def _run_diagnosis(config, function, tests, always):
 def _diagnose(config):
     """Diagnose every function that lost points.
 
-    Students see the diagnosis of the public tests only (their calls and
-    verdicts): in the top-level summary and first in each public test it
+    Students see the diagnosis of the public tests (their calls and
+    verdicts) in the top-level summary and first in each public test it
     explains. The diagnosis of all tests, hidden ones included, is kept for
-    instructors (the results' ``extra_data`` and the terminal table).
+    instructors (the results' ``extra_data`` and the terminal table), and
+    shown first in each hidden test it explains, which students see after
+    publication only.
     """
     impl = config.stash.get(_IMPL_KEY, None)
     results = config.stash.get(_RESULTS_KEY, {})
@@ -214,6 +216,13 @@ def _diagnose(config):
             found_all = _run_diagnosis(config, function, tests, always)
             if found_all is not None:
                 everything[function] = found_all[1]
+                # A hidden test it explains says it too, in the catalogue's words: shown with that test's
+                # fixed line, after publication only (its visibility), never in the summary shown at once.
+                for nodeid in found_all[0].explains:
+                    result = results[nodeid]
+                    said = found_all[0].id in diagnosis.ONE_LINE_ALREADY  # the test's own line says it
+                    if result.hidden and not result.passed and not always and not said:
+                        result.diagnosis = found_all[1]["message"]
         elif function in public:
             everything[function] = public[function]
     config.stash[_DIAGNOSES_KEY] = (public, everything)
