@@ -82,11 +82,14 @@ class Outcome:
 @dataclass(frozen=True)
 class Diagnosis:
     """What :func:`diagnose` found: an ``id`` (for the project's own checks),
-    the line for the student, and the failed tests it explains."""
+    the line for the student, and the failed tests it explains. ``catalogue``:
+    a known mistake's fixed line (never text of the submission's or of a
+    test's data, so a hidden test may show it)."""
 
     id: str
     message: str
     explains: tuple = field(default_factory=tuple)
+    catalogue: bool = field(default=False, compare=False)
 
 
 # -- the contract's signatures -------------------------------------------------------
@@ -521,7 +524,7 @@ def _known_mistake(function, calls, outcomes, failed, context):
         if explained and len(explained) > len(contradicted) and len(explained) >= len(unexplained):
             key = (len(explained), -len(contradicted), -absent, evidence)
             if best_key is None or key > best_key:
-                best, best_key = Diagnosis(mistake.id, mistake.message, explained), key
+                best, best_key = Diagnosis(mistake.id, mistake.message, explained, catalogue=True), key
     return best
 
 

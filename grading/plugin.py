@@ -216,13 +216,13 @@ def _diagnose(config):
             found_all = _run_diagnosis(config, function, tests, always)
             if found_all is not None:
                 everything[function] = found_all[1]
-                # A hidden test it explains says it too, in the catalogue's words: shown with that test's
-                # fixed line, after publication only (its visibility), never in the summary shown at once.
-                for nodeid in found_all[0].explains:
+                # A hidden test it explains says it too when it is a known mistake's fixed line (the other
+                # findings may quote the submission's text): with that test's own fixed line, after
+                # publication only (its visibility), never in the summary shown at once.
+                for nodeid in found_all[0].explains if found_all[0].catalogue else ():
                     result = results[nodeid]
-                    said = found_all[0].id in diagnosis.ONE_LINE_ALREADY  # the test's own line says it
-                    if result.hidden and not result.passed and not always and not said:
-                        result.diagnosis = found_all[1]["message"]
+                    if result.hidden and not result.passed and not always:
+                        result.diagnosis = clean(found_all[0].message)
         elif function in public:
             everything[function] = public[function]
     config.stash[_DIAGNOSES_KEY] = (public, everything)

@@ -3,6 +3,7 @@ and lost points for every wrong submission in tests/mutants."""
 
 import ast
 import importlib
+import json
 import subprocess
 import sys
 
@@ -592,3 +593,18 @@ def test_the_hidden_points_a_local_run_announces_are_the_hidden_tests_points(ref
         if test["visibility"] != "visible":
             graded[test["tags"][0]] = graded.get(test["tags"][0], 0.0) + test["max_score"]
     assert hidden_points() == graded
+
+
+def test_a_hidden_test_shows_a_known_mistakes_line_but_never_a_finding_that_quotes_the_submission(tmp_path):
+    """Issue 36: a hidden test names the catalogue's mistake (fixed words); a finding that quotes the
+    submission, such as the same exception everywhere, stays in the instructors' extra_data."""
+    module = tmp_path / "metrics.py"
+    module.write_text(
+        "from solutions.metrics import *  # noqa: F401,F403\n\n\n"
+        "def chamfer_distance(a, b):\n    raise RuntimeError('leaked 4711')\n"
+    )
+    summary, _ = grade("--reference", "--impl-module", f"metrics={module}", "-k", "test_chamfer_distance_",
+                       tmp_path=tmp_path)  # fmt: skip
+    hidden = [t for t in summary["tests"] if t["visibility"] == "after_published"]
+    assert hidden and not any("4711" in t["output"] or "diagnosis" in t["output"] for t in hidden)
+    assert "4711" in json.dumps(summary["extra_data"]["all_diagnoses"])  # the instructor sees it
