@@ -415,9 +415,11 @@ def bst_own_swap(keys, left, right, query, k, partner="unreached", margin=TRAP_M
     - ``partner="reached"``, a trap through C, which :func:`bst_trap_swaps`
       makes only when a childless node's key is nearer the query than C's
       (rarely: C's key is one of the query's two neighbours among the keys).
-      U is a childless node the rule reads whose key lies beyond the k-th
-      distance; C's key, in the answer, moves to U. A search that keeps the
-      keys swapped both ways but those through C drops it.
+      U is a childless node whose interval lies within the k-th distance
+      (so every lawful search reads it, best-bin-first too, which before U
+      reads only nodes nearer than U's interval) and whose key lies beyond
+      it; C's key, in the answer, moves to U. A search that keeps the keys
+      swapped both ways but those through C drops it.
 
     The reach is worked out again on the new keys: U must stay unreached (or
     reached), with no far-side test within ``margin`` of a tie, and a trap's
@@ -458,6 +460,9 @@ def bst_own_swap(keys, left, right, query, k, partner="unreached", margin=TRAP_M
     is_reached[sorted(reached)] = True
     want_reached = partner == "reached"
     fit = childless & inside & (is_reached == want_reached) & (gaps > bound * (1 + TRAP_MARGIN))
+    if want_reached:  # U's interval within the k-th distance: every lawful search reads U, best-bin-first too
+        interval_gap = np.maximum(np.maximum(lo - query, query - hi), 0.0)
+        fit &= interval_gap <= bound * (1 - TRAP_MARGIN)
     fit[c] = False
     candidates = np.flatnonzero(fit)
     for u in candidates[np.argsort(gaps[candidates], kind="stable")][:TRIES]:

@@ -143,9 +143,12 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
             if on_keys:  # a query equal to a key of its path: the contract goes right first (equal keys go right)
                 query = keys[rng.choice(lying_trees.bst_descent(keys, left, right, query))]
             # Every other query gets a counter-decoy (a decoy swapped both ways with the key of the node where
-            # the query's descent ends, C); the others a trap through C. The other traps avoid C.
+            # the query's descent ends, C), the others a trap through C (each the other where it cannot).
             partner = ("reached", "unreached")[turn % 2]
             true_keys, pair = lying_trees.bst_own_swap(keys, left, right, query, k, partner=partner)
+            if pair is None:  # the other kind, where this one finds no partner
+                partner = ("unreached", "reached")[turn % 2]
+                true_keys, pair = lying_trees.bst_own_swap(keys, left, right, query, k, partner=partner)
             reached, margin = trees.bst_reach(true_keys, left, right, query, k)
             if margin < MARGIN:
                 continue

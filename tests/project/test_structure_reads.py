@@ -104,11 +104,32 @@ def bst_interval_pruning(keys, left, right, query, k):
     return np.array([i for _, i in held], dtype=np.int64), np.array([d for d, _ in held])
 
 
+def bst_best_bin_first(keys, left, right, query, k):
+    """Nodes from a priority queue by their interval's distance, until the nearest left is beyond the k-th.
+
+    A node enters the queue from its parent only, and its interval's distance is at least the parent's
+    ``|key - query|``: it reads only nodes the rule reads (issue 35's third hostile review found a swap
+    that failed it: a trap's key moved to a node whose interval lay beyond the k-th distance).
+    """
+    keys = np.asarray(keys, dtype=float)
+    held, queue = [], [(0.0, 0, -np.inf, np.inf)]  # held: (distance, node), sorted
+    while queue:
+        gap, node, lo, hi = heapq.heappop(queue)
+        if len(held) == k and gap > held[-1][0]:
+            break
+        held = sorted([*held, (abs(keys[node] - query), node)])[:k]
+        for child, a, b in ((left[node], lo, min(hi, keys[node])), (right[node], max(lo, keys[node]), hi)):
+            if child >= 0:
+                heapq.heappush(queue, (max(a - query, query - b, 0.0), int(child), a, b))
+    return np.array([i for _, i in held], dtype=np.int64), np.array([d for d, _ in held])
+
+
 def lawful(function):
     """Every correct search of ``function`` the project knows, by name."""
     if function == "bst_knn":
         found = {"reference": nn.bst_knn, "grader's rule": lambda keys, *rest: tree_searches.bst_search(keys, *rest)}
         found["interval pruning (this file)"] = bst_interval_pruning
+        found["best-bin-first (this file)"] = bst_best_bin_first
     else:
         found = {"reference": getattr(nn, function), "grader's rule": grader_rule(function)}
     found["mutants' plain search"] = getattr(_plain_trees, function)
