@@ -306,7 +306,7 @@ def bst_filtered_search(keys, left, right, query, k, nested=True, mutual=False):
     under a node whose key lies outside its own interval). ``mutual=True``
     keeps, of the keys outside their intervals, those swapped both ways (the
     descent of each ends at the other's node), as the traps are
-    (:func:`lying_trees.bst_own_swap` gives a decoy such a partner).
+    (:func:`lying_keys.bst_own_swap` gives a decoy such a partner).
     """
     kept, strays, stack = [], [], [(0, -math.inf, math.inf)]
     while stack:

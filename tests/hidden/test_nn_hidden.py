@@ -27,8 +27,8 @@ a far point of the query's own leaf moved into the decoy's leaf, so that the
 decoy's misplacement is as mutual as a trap's. A search that keeps the
 out-of-cell points swapped both ways (to keep the traps) and drops the rest
 keeps such a decoy, and returns it. The BST has both too, on its keys
-(:func:`grading.instructors.lying_trees.bst_trap_swaps` and
-:func:`grading.instructors.lying_trees.bst_own_swap`): only the keys
+(:func:`grading.instructors.lying_keys.bst_trap_swaps` and
+:func:`grading.instructors.lying_keys.bst_own_swap`): only the keys
 of childless nodes can move without changing where a search goes.
 """
 
@@ -38,7 +38,7 @@ import pytest
 from grading.checks import as_list, check_array
 from grading.checks.nn import check_csr, check_kdtree, check_knn, check_octree
 from grading.errors import CheckFailed
-from grading.instructors import lying_trees, trees
+from grading.instructors import lying_keys, lying_trees, trees
 
 pytestmark = pytest.mark.hidden
 
@@ -141,20 +141,20 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
     for k, count, on_keys in ((1, 4, False), (5, 4, False), (12, 12, False), (5, 6, True)):
         for turn, query in enumerate(rng.uniform(100, 900, count)):
             if on_keys:  # a query equal to a key of its path: the contract goes right first (equal keys go right)
-                query = keys[rng.choice(lying_trees.bst_descent(keys, left, right, query))]
+                query = keys[rng.choice(lying_keys.bst_descent(keys, left, right, query))]
             # Every other query gets a counter-decoy (a decoy swapped both ways with the key of the node where
             # the query's descent ends, C), the others a trap through C (each the other where it cannot).
             partner = ("reached", "unreached")[turn % 2]
-            true_keys, pair = lying_trees.bst_own_swap(keys, left, right, query, k, partner=partner)
+            true_keys, pair = lying_keys.bst_own_swap(keys, left, right, query, k, partner=partner)
             if pair is None:  # the other kind, where this one finds no partner
                 partner = ("unreached", "reached")[turn % 2]
-                true_keys, pair = lying_trees.bst_own_swap(keys, left, right, query, k, partner=partner)
+                true_keys, pair = lying_keys.bst_own_swap(keys, left, right, query, k, partner=partner)
             reached, margin = trees.bst_reach(true_keys, left, right, query, k)
             if margin < MARGIN:
                 continue
             gaps = np.sort(np.abs(true_keys - query))
             nearest = np.min(gaps[gaps > 0])
-            trapped_keys, trapped = lying_trees.bst_trap_swaps(true_keys, left, right, query, k)
+            trapped_keys, trapped = lying_keys.bst_trap_swaps(true_keys, left, right, query, k)
             traps += len(trapped) // 2
             unreached = np.setdiff1d(np.arange(len(keys)), sorted(reached))
             if pair is not None and partner == "reached":
@@ -162,7 +162,7 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
                 trapped = np.concatenate([trapped, pair])
             elif pair is not None:
                 counters += 1  # U's ancestors keep their keys: U's interval is the true tree's
-                unreached = np.setdiff1d(unreached, lying_trees.bst_descent(keys, left, right, keys[pair[1]])[:-1])
+                unreached = np.setdiff1d(unreached, lying_keys.bst_descent(keys, left, right, keys[pair[1]])[:-1])
             lying = trapped_keys.copy()  # the decoys: spread in the k-th distance, as the keys are
             lying[unreached] = trees.decoy_places(query, gaps[k - 1] or nearest, len(unreached), rng)[:, 0]
             if pair is not None and partner == "unreached":  # U's decoy lies in C's interval: between the query

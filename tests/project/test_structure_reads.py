@@ -27,7 +27,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from grading.errors import CheckFailed
-from grading.instructors import lying_trees, tree_searches, trees
+from grading.instructors import lying_keys, lying_trees, tree_searches, trees
 from solutions import nn
 from tests.hidden import test_nn_hidden as hidden
 from tests.mutants import _bst_filter, _cell_filter, _plain_trees
@@ -386,9 +386,9 @@ def test_on_trapped_bst_keys_lawful_searches_read_within_their_reads_and_answer_
     for query in rng.uniform(50, 950, 60):
         k = int(rng.integers(2, 30))
         true_keys, pair = (
-            (keys, None) if partner is None else lying_trees.bst_own_swap(keys, left, right, query, k, partner)
+            (keys, None) if partner is None else lying_keys.bst_own_swap(keys, left, right, query, k, partner)
         )
-        lying, swapped = lying_trees.bst_trap_swaps(true_keys, left, right, query, k)
+        lying, swapped = lying_keys.bst_trap_swaps(true_keys, left, right, query, k)
         planted += len(swapped) // 2 if partner is None else pair is not None
         reached = trees.bst_reach(lying, left, right, query, k)[0]
         assert reached <= trees.bst_reach(true_keys, left, right, query, k)[0]  # the traps read nothing new

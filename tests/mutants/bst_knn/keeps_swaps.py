@@ -3,7 +3,7 @@
 The BST's form of issue 35's hostile review (hole 5): the traps are swaps
 (each of two keys in the other's interval), the decoys were one-way, so
 keeping the mutual misplacements and dropping the rest passed every
-structure test. The counter-decoys (lying_trees.bst_own_swap) give a decoy a
+structure test. The counter-decoys (lying_keys.bst_own_swap) give a decoy a
 partner: the node where the query's descent ends takes the decoy's node's
 key, so the decoy is kept and returned.
 """
