@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from grading.instructors import lying_trees
-from grading.instructors.trees import Best, brute_knn, brute_radius, cell_gap_squared, is_octree_leaf, squared_distances
+from grading.instructors.trees import Best, brute_knn, brute_radius, is_octree_leaf, squared_distances
 
 
 def _as_rows(queries, width):
@@ -171,59 +171,91 @@ def octree_search(
     xyz, queries = measured[:, :3], rows[:, :3]
     if not every_column:
         measured, rows = xyz, queries
+    # The cubes as Python floats: a search visits many nodes and tests 3-vectors, where NumPy's
+    # per-call cost dominates (the diagnosis runs this for every known mistake on every call).
+    # The arithmetic is the same as NumPy's, term by term in increasing axis, so the verdicts
+    # on a face or a plane are the same.
+    centers, extents = tree["center"].tolist(), tree["extent"].tolist()
+    children = tree["children"].tolist()
+    leaf = [max(codes) < 0 for codes in children]
+    order, start, stop = tree["order"], tree["start"], tree["stop"]
     results = []
 
-    def meets(query, node, w2):
-        c, e = tree["center"][node], tree["extent"][node]
-        if box:
-            return bool(np.all(np.abs(query - c) <= e + math.sqrt(w2)))
-        if unclamped:
-            return float(np.sum((np.abs(query - c) - e) ** 2)) <= w2
-        return cell_gap_squared(query, c, e) < w2 if strict else cell_gap_squared(query, c, e) <= w2
+    def sum_of_squares(a, b, c):
+        return a * a + b * b + c * c  # NumPy's x ** 2 is x * x, summed in increasing axis
 
-    for query, row in zip(queries, rows):
+    def gap_squared(query, node):
+        c, e = centers[node], extents[node]
+        gaps = [abs(query[j] - c[j]) - e for j in range(3)]
+        if not unclamped:
+            gaps = [max(gap, 0.0) for gap in gaps]
+        return sum_of_squares(*gaps)
+
+    def meets(query, node, w2):
+        if box:
+            reach = extents[node] + math.sqrt(w2)
+            return all(abs(query[j] - centers[node][j]) <= reach for j in range(3))
+        return gap_squared(query, node) < w2 if strict else gap_squared(query, node) <= w2
+
+    def far_corner_squared(query, node):
+        c, e = centers[node], extents[node]
+        return sum_of_squares(*[abs(query[j] - c[j]) + e for j in range(3)])
+
+    listed, measured_rows = order.tolist(), measured.tolist()
+    radius_squared = None if radius is None else radius**2
+
+    def squared_distance(point, row):
+        total = 0.0
+        for p, q in zip(point, row):  # in increasing column, as squared_distances
+            total += (p - q) * (p - q)
+        return total
+
+    for query_array, row_array in zip(queries, rows):
+        query, row = query_array.tolist(), row_array.tolist()
         best = _best(k, sentinel) if k is not None else None
         found = []
 
         def offer(node, everything=False, row=row, best=best, found=found):
-            indices = tree["order"][tree["start"][node] : tree["stop"][node]]
-            s = squared_distances(measured[indices], row)
+            indices = listed[start[node] : stop[node]]
+            s = [squared_distance(measured_rows[i], row) for i in indices]
             if best is not None:
-                best.offer_all(s, indices)
-            else:
-                keep = np.ones(len(s), dtype=bool) if everything else (s <= radius**2) & ((s > 0) | (not drop_zero))
-                if stop_at_miss and not keep.all():
-                    keep[np.argmin(keep) :] = False
-                if everything and contained_at_radius:
-                    s = np.full(len(s), radius**2)
-                found.extend(zip(s[keep].tolist(), indices[keep].tolist()))
+                best.held = sorted([*best.held, *zip(s, indices)])[: best.k]
+                return
+            keep = [everything or (d <= radius_squared and (d > 0 or not drop_zero)) for d in s]
+            if stop_at_miss and not all(keep):
+                keep[keep.index(False) :] = [False] * (len(keep) - keep.index(False))
+            if everything and contained_at_radius:
+                s = [radius_squared] * len(s)
+            found.extend((d, i) for d, i, kept in zip(s, indices, keep) if kept)
 
         def radius_visit(node, query=query):
-            c, e = tree["center"][node], tree["extent"][node]
-            if contains and float(np.sum((np.abs(query - c) + e) ** 2)) <= radius**2:
+            if contains and far_corner_squared(query, node) <= radius**2:
                 offer(node, everything=True)
-            elif is_octree_leaf(tree, node):
+            elif leaf[node]:
                 offer(node)
             else:
                 for code in range(8):
-                    child = tree["children"][node, code]
+                    child = children[node][code]
                     if child >= 0 and meets(query, child, radius**2):
                         radius_visit(child)
 
         def knn_visit(node, query=query, best=best):
-            c, e = tree["center"][node], tree["extent"][node]
-            if is_octree_leaf(tree, node):
+            c, e = centers[node], extents[node]
+            if leaf[node]:
                 offer(node)
             else:
                 axes = [0, 0, 0] if code_from_x else [0, 1, 2]
-                above = query >= c if upper_on_plane else query > c
-                own = sum(1 << j for j, a in enumerate(axes) if above[a])
+                above = [query[a] >= c[a] if upper_on_plane else query[a] > c[a] for a in axes]
+                own = sum(1 << j for j in range(3) if above[j])
                 codes = [own] + [i for i in range(8) if i != own] if own_first else list(range(8))
                 for code in codes:
-                    child = tree["children"][node, code]
+                    child = children[node][code]
                     if child >= 0 and meets(query, child, best.worst) and knn_visit(child):
                         return True
-            return early and bool(np.all(np.abs(query - c) + math.sqrt(best.worst) < e))
+            if not early:
+                return False
+            reach = math.sqrt(best.worst)
+            return all(abs(query[j] - c[j]) + reach < e for j in range(3))
 
         if k is not None:
             knn_visit(0)

@@ -24,44 +24,44 @@ __all__ = ["kdtree_knn", "kdtree_radius", "octree_knn", "octree_radius", "kept_b
 TOLERANCE = 1e-9
 
 
-def _kd_kept(tree, points, query, own_leaf):
-    """Indices of the points that lie in their leaf's box (and, with ``own_leaf``, all of the query's leaf)."""
-    kept = []
-    stack = [(0, np.full(points.shape[1], -np.inf), np.full(points.shape[1], np.inf), True)]
-    while stack:
-        node, lower, upper, own = stack.pop()
-        if tree["axis"][node] < 0:
-            indices = tree["order"][tree["start"][node] : tree["stop"][node]]
-            slack = TOLERANCE * (
-                1 + np.abs(np.where(np.isfinite(lower), lower, 0)) + np.abs(np.where(np.isfinite(upper), upper, 0))
-            )
-            inside = np.all((points[indices] >= lower - slack) & (points[indices] <= upper + slack), axis=1)
-            kept.extend(indices if (own and own_leaf) else indices[inside])
-            continue
-        a, s = tree["axis"][node], tree["split"][node]
-        left_upper, right_lower = upper.copy(), lower.copy()
-        left_upper[a], right_lower[a] = min(upper[a], s), max(lower[a], s)
-        goes_left = query[a] <= s
-        stack.append((tree["left"][node], lower, left_upper, own and goes_left))
-        stack.append((tree["right"][node], right_lower, upper, own and not goes_left))
-    return np.array(sorted(kept), dtype=np.int64)
-
-
-def _octree_kept(tree, xyz, query, own_leaf):
-    kept = []
-    stack = [(0, True)]
-    while stack:
-        node, own = stack.pop()
-        children = tree["children"][node]
+def _inside_their_leaf(tree, points):
+    """Whether each point lies in the cell of the leaf that lists it: the k-d tree's box from its
+    ancestors' splits (closed), the octree's cube (centre +- extent), each with the tolerance. The
+    same for every query, so a search computes it once."""
+    inside = np.zeros(len(points), dtype=bool)
+    if "axis" in tree:
+        stack = [(0, np.full(points.shape[1], -np.inf), np.full(points.shape[1], np.inf))]
+        while stack:
+            node, lower, upper = stack.pop()
+            if tree["axis"][node] < 0:
+                indices = tree["order"][tree["start"][node] : tree["stop"][node]]
+                slack = TOLERANCE * (
+                    1 + np.abs(np.where(np.isfinite(lower), lower, 0)) + np.abs(np.where(np.isfinite(upper), upper, 0))
+                )
+                members = points[indices]
+                inside[indices] = np.all((members >= lower - slack) & (members <= upper + slack), axis=1)
+                continue
+            a, s = tree["axis"][node], tree["split"][node]
+            left_upper, right_lower = upper.copy(), lower.copy()
+            left_upper[a], right_lower[a] = min(upper[a], s), max(lower[a], s)
+            stack += [(tree["left"][node], lower, left_upper), (tree["right"][node], right_lower, upper)]
+        return inside
+    xyz = points[:, :3]
+    for node in np.flatnonzero(np.all(tree["children"] < 0, axis=1)):
         center, extent = tree["center"][node], tree["extent"][node]
-        if np.all(children < 0):
-            indices = tree["order"][tree["start"][node] : tree["stop"][node]]
-            inside = np.all(np.abs(xyz[indices] - center) <= extent + TOLERANCE * (1 + np.abs(center) + extent), axis=1)
-            kept.extend(indices if (own and own_leaf) else indices[inside])
-            continue
-        code = int(sum(1 << j for j in range(3) if query[j] > center[j]))
-        stack.extend((int(child), own and c == code) for c, child in enumerate(children) if child >= 0)
-    return np.array(sorted(kept), dtype=np.int64)
+        indices = tree["order"][tree["start"][node] : tree["stop"][node]]
+        reach = extent + TOLERANCE * (1 + np.abs(center) + extent)
+        inside[indices] = np.all(np.abs(xyz[indices] - center) <= reach, axis=1)
+    return inside
+
+
+def _kept(tree, inside, query, own_leaf):
+    """The points in their leaf's cell and, with ``own_leaf``, every point of the query's own leaf."""
+    kept = inside.copy()
+    own = _own(tree, query) if own_leaf else None
+    if own is not None:
+        kept[tree["order"][tree["start"][own] : tree["stop"][own]]] = True
+    return np.flatnonzero(kept).astype(np.int64)
 
 
 def _leaf_cells(tree, width):
@@ -139,9 +139,8 @@ def kept_by_cell(tree, points, query, own_leaf=False, mutual=False):
         width = points.shape[1] if "axis" in tree else 3
         spare = _own(tree, np.asarray(query, dtype=float)[:width]) if mutual == "but_its_own_leaf" else None
         return _mutual_kept(tree, points[:, :width], spare)
-    if "axis" in tree:
-        return _kd_kept(tree, points, np.asarray(query, dtype=float), own_leaf)
-    return _octree_kept(tree, points[:, :3], np.asarray(query, dtype=float)[:3], own_leaf)
+    width = points.shape[1] if "axis" in tree else 3
+    return _kept(tree, _inside_their_leaf(tree, points), np.asarray(query, dtype=float)[:width], own_leaf)
 
 
 def _squared(points, indices, query):
@@ -152,8 +151,14 @@ def _knn(tree, points, queries, k, own_leaf, width, mutual=False):
     points = np.asarray(points, dtype=float)[:, :width]
     rows, dists = [], []
     shared = _mutual_kept(tree, points) if mutual is True else None  # the same for every query
+    in_cell = _inside_their_leaf(tree, points) if not mutual else None  # the same for every query
     for query in np.asarray(queries, dtype=float)[:, :width]:
-        kept = shared if shared is not None else kept_by_cell(tree, points, query, own_leaf, mutual)
+        if shared is not None:
+            kept = shared
+        elif in_cell is not None:
+            kept = _kept(tree, in_cell, query, own_leaf)
+        else:
+            kept = kept_by_cell(tree, points, query, own_leaf, mutual)
         s = _squared(points, kept, query)
         rank = np.lexsort((kept, s))[:k]
         rows.append(kept[rank])
@@ -165,8 +170,14 @@ def _radius(tree, points, queries, radius, own_leaf, width, mutual=False):
     points = np.asarray(points, dtype=float)[:, :width]
     rows, dists = [], []
     shared = _mutual_kept(tree, points) if mutual is True else None  # the same for every query
+    in_cell = _inside_their_leaf(tree, points) if not mutual else None  # the same for every query
     for query in np.asarray(queries, dtype=float)[:, :width]:
-        kept = shared if shared is not None else kept_by_cell(tree, points, query, own_leaf, mutual)
+        if shared is not None:
+            kept = shared
+        elif in_cell is not None:
+            kept = _kept(tree, in_cell, query, own_leaf)
+        else:
+            kept = kept_by_cell(tree, points, query, own_leaf, mutual)
         s = _squared(points, kept, query)
         inside = s <= radius**2
         rank = np.lexsort((kept[inside], s[inside]))

@@ -1,5 +1,7 @@
 """Fixtures of the project's tests."""
 
+import shutil
+import tempfile
 import zlib
 from pathlib import Path
 
@@ -16,6 +18,19 @@ def pytest_collection_modifyitems(items):
     for item in items:
         if item.path.is_relative_to(PROJECT_TESTS) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(TEST_BACKSTOP))
+
+
+@pytest.fixture(autouse=True)
+def own_temporary_folder(monkeypatch):
+    """Every temporary folder a test makes in this process (a staged submission, a grading's
+    options) goes into a folder of its own, removed after the test: a test that stages a
+    submission for a worker of its own never leaves it in /tmp. Mode 0711, as /tmp's
+    sticky folder is traversable: a worker of another uid reaches the staged root below it."""
+    folder = tempfile.mkdtemp(prefix="pcl-test-")
+    Path(folder).chmod(0o711)
+    monkeypatch.setattr(tempfile, "tempdir", folder)
+    yield
+    shutil.rmtree(folder, ignore_errors=True)
 
 
 @pytest.fixture

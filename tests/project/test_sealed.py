@@ -289,14 +289,15 @@ PAYLOADS = (
 )
 
 MEASURE = """
-import json, sys
+import json, shutil, sys
 sys.path[:0] = [{tests!r}]
 from pathlib import Path
 from grading.sandbox import Worker
 from grading.staging import stage
 import grading.plugin  # the grading process's own modules, as when it grades
 
-worker = Worker(stage(Path({package!r})).root, timeout=30)
+staged = stage(Path({package!r}))
+worker = Worker(staged.root, timeout=30)
 outcomes = {{}}
 for name in {payloads!r}:
     try:
@@ -306,6 +307,7 @@ for name in {payloads!r}:
     except Exception as exc:
         outcomes[name] = type(exc).__name__ + ": " + str(exc).splitlines()[0][:200]
 worker.close()
+shutil.rmtree(staged.root)
 # VmHWM: this process's own peak. (getrusage's ru_maxrss keeps the parent's size at fork across exec.)
 peak = next(line for line in open("/proc/self/status") if line.startswith("VmHWM:"))
 print(json.dumps({{"peak_mib": int(peak.split()[1]) / 1024, "outcomes": outcomes}}))
