@@ -181,25 +181,27 @@ def octree_search(
     order, start, stop = tree["order"], tree["start"], tree["stop"]
     results = []
 
-    def sum_of_squares(a, b, c):
-        return a * a + b * b + c * c  # NumPy's x ** 2 is x * x, summed in increasing axis
-
     def gap_squared(query, node):
         c, e = centers[node], extents[node]
-        gaps = [abs(query[j] - c[j]) - e for j in range(3)]
-        if not unclamped:
-            gaps = [max(gap, 0.0) for gap in gaps]
-        return sum_of_squares(*gaps)
+        g0, g1, g2 = abs(query[0] - c[0]) - e, abs(query[1] - c[1]) - e, abs(query[2] - c[2]) - e
+        if not unclamped:  # each axis's gap clamped at 0 (its square is the same for -0.0)
+            g0, g1, g2 = (g0 if g0 > 0.0 else 0.0), (g1 if g1 > 0.0 else 0.0), (g2 if g2 > 0.0 else 0.0)
+        return g0 * g0 + g1 * g1 + g2 * g2  # NumPy's x ** 2 is x * x, summed in increasing axis
 
     def meets(query, node, w2):
         if box:
-            reach = extents[node] + math.sqrt(w2)
-            return all(abs(query[j] - centers[node][j]) <= reach for j in range(3))
+            reach, c = extents[node] + math.sqrt(w2), centers[node]
+            return abs(query[0] - c[0]) <= reach and abs(query[1] - c[1]) <= reach and abs(query[2] - c[2]) <= reach
         return gap_squared(query, node) < w2 if strict else gap_squared(query, node) <= w2
 
     def far_corner_squared(query, node):
         c, e = centers[node], extents[node]
-        return sum_of_squares(*[abs(query[j] - c[j]) + e for j in range(3)])
+        f0, f1, f2 = abs(query[0] - c[0]) + e, abs(query[1] - c[1]) + e, abs(query[2] - c[2]) + e
+        return f0 * f0 + f1 * f1 + f2 * f2
+
+    # The order a node's children are visited in, by the query's own code.
+    visiting = [[own] + [i for i in range(8) if i != own] if own_first else list(range(8)) for own in range(8)]
+    code_axes = (0, 0, 0) if code_from_x else (0, 1, 2)
 
     listed, measured_rows = order.tolist(), measured.tolist()
     radius_squared = None if radius is None else radius**2
@@ -244,11 +246,11 @@ def octree_search(
             if leaf[node]:
                 offer(node)
             else:
-                axes = [0, 0, 0] if code_from_x else [0, 1, 2]
-                above = [query[a] >= c[a] if upper_on_plane else query[a] > c[a] for a in axes]
-                own = sum(1 << j for j in range(3) if above[j])
-                codes = [own] + [i for i in range(8) if i != own] if own_first else list(range(8))
-                for code in codes:
+                own = 0
+                for bit, a in enumerate(code_axes):
+                    if (query[a] >= c[a]) if upper_on_plane else (query[a] > c[a]):
+                        own |= 1 << bit
+                for code in visiting[own]:
                     child = children[node][code]
                     if child >= 0 and meets(query, child, best.worst) and knn_visit(child):
                         return True
