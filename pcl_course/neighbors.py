@@ -72,13 +72,24 @@ def radius_neighbors(points, radius, queries=None, workers=1):
     return [np.asarray(row, dtype=np.int64) for row in lists]
 
 
-def scipy_kdtree(points, leaf_size=16, balanced_tree=True):
+def scipy_kdtree(points, leaf_size=16, balanced_tree=True, compact_nodes=True):
     """SciPy's k-d tree of ``points``, in the layout of ``pcl_course.nn.kdtree_build``.
 
-    For comparing split rules: with ``balanced_tree=True`` (SciPy's default)
-    a node splits at the median of its axis of largest spread; with ``False``,
-    at the middle of its cell's longest side, slid to the nearest point if a
-    side would be empty (sliding midpoint). Neither is the course's rule.
+    For comparing split rules. SciPy picks a node's split axis where its box
+    is widest, then cuts it:
+
+    - ``balanced_tree=True`` (SciPy's default): at the median of the node's
+      points along that axis;
+    - ``balanced_tree=False, compact_nodes=True``: at the middle of the
+      points' spread along that axis (both sides always hold points, so the
+      cut never slides);
+    - ``balanced_tree=False, compact_nodes=False``: the sliding midpoint of
+      Maneewongvatana and Mount: at the middle of the node's *cell*, slid to
+      the nearest point if one side would be empty.
+
+    With ``compact_nodes=True`` the box is the node's points' bounding box,
+    otherwise its cell. None of these is the course's rule (the median, the
+    axes in turn).
 
     Parameters
     ----------
@@ -86,6 +97,7 @@ def scipy_kdtree(points, leaf_size=16, balanced_tree=True):
     leaf_size : int, default 16
         SciPy's ``leafsize``: nodes of at most this many points are leaves.
     balanced_tree : bool, default True
+    compact_nodes : bool, default True
 
     Returns
     -------
@@ -97,7 +109,7 @@ def scipy_kdtree(points, leaf_size=16, balanced_tree=True):
     if points.ndim != 2 or len(points) == 0:
         raise ValueError(f"points must be a non-empty (N, D) array, got shape {points.shape}")
     leaf_size = check_integer(leaf_size, "leaf_size", low=1)
-    tree = cKDTree(points, leafsize=leaf_size, balanced_tree=bool(balanced_tree))
+    tree = cKDTree(points, leafsize=leaf_size, balanced_tree=bool(balanced_tree), compact_nodes=bool(compact_nodes))
     columns = {key: [] for key in ("start", "stop", "axis", "split", "left", "right")}
     stack = [(tree.tree, -1, "")]  # (node, parent id, which child of the parent)
     while stack:  # preorder: a node, its lesser subtree, its greater subtree

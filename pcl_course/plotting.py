@@ -67,7 +67,7 @@ def set_axes_equal(ax, points=None):
     ax.set_xlim3d(centre[0] - half, centre[0] + half)
     ax.set_ylim3d(centre[1] - half, centre[1] + half)
     ax.set_zlim3d(centre[2] - half, centre[2] + half)
-    ax.set_box_aspect((1, 1, 1))
+    ax.set_box_aspect((1, 1, 1), zoom=0.9)  # a margin for the z label, which a full-size box pushes out of the figure
     return ax
 
 
@@ -540,7 +540,7 @@ def _ticks_at(ax, x, most=10):
 
 
 def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vline=None, floor=None,
-           figsize=(7, 4)):  # fmt: skip
+           figsize=(7, 4), styles=None):  # fmt: skip
     """Several curves over one x axis, with a legend.
 
     Parameters
@@ -552,13 +552,20 @@ def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vli
         A dotted vertical line and its legend label.
     floor : float, optional
         Values below it are drawn at it (a log scale has no 0).
+    styles : sequence of str, optional
+        Line styles for curves that come in groups (``["-", "--"]``: pairs):
+        curve ``j`` is drawn with ``styles[j % len(styles)]`` in the group's
+        colour, ``j // len(styles)``. Default: one colour per curve, solid.
     """
     import matplotlib.pyplot as plt
 
+    styles = ["-"] if styles is None else list(styles)
     fig, ax = plt.subplots(1, 1, figsize=figsize)
-    for label, ys in values.items():
+    for j, (label, ys) in enumerate(values.items()):
         ys = np.asarray(ys, dtype=float)
-        ax.plot(x, ys if floor is None else np.maximum(ys, floor), marker="o", label=label)
+        colour = f"C{j // len(styles) if len(styles) > 1 else j}"
+        ax.plot(x, ys if floor is None else np.maximum(ys, floor), marker="o", label=label,
+                ls=styles[j % len(styles)], color=colour)  # fmt: skip
     if vline is not None:
         ax.axvline(vline[0], ls=":", c="gray", label=vline[1])
     ax.set(xlabel=xlabel, ylabel=ylabel, xscale=xscale, yscale=yscale)
@@ -740,15 +747,17 @@ def accuracy_against_samples(published, measured_sizes, measured, chance, publis
     import matplotlib.pyplot as plt
 
     fig, (paper, ours) = plt.subplots(1, 2, figsize=(11, 4.8), sharey=True, layout="constrained")
+    # One colour per sampler across both panels, and never one colour for two samplers.
+    names = list(dict.fromkeys([*published, *measured]))
+    colours = {name: f"C{i}" for i, name in enumerate(names)}
     for label, (sizes, values) in published.items():
-        paper.semilogx(sizes, values, marker="o", label=label)
+        paper.semilogx(sizes, values, marker="o", label=label, color=colours[label])
     paper.set(title=published_title, xlabel="points per test cloud", ylabel="accuracy (%)")
-    colours = {}
     for name, values in measured.items():
         values = np.atleast_2d(values)
-        (line,) = ours.semilogx(measured_sizes, values.mean(axis=0), marker="o", label=f"{name}, trained on full")
-        ours.fill_between(measured_sizes, values.min(axis=0), values.max(axis=0), color=line.get_color(), alpha=0.2)
-        colours[name] = line.get_color()
+        ours.semilogx(measured_sizes, values.mean(axis=0), marker="o", label=f"{name}, trained on full",
+                      color=colours[name])  # fmt: skip
+        ours.fill_between(measured_sizes, values.min(axis=0), values.max(axis=0), color=colours[name], alpha=0.2)
     for name, (sizes, values) in (matched or {}).items():
         values = np.atleast_2d(values)
         mean = values.mean(axis=0)
@@ -889,12 +898,13 @@ def _box_distance(query, low, high):
     return float(np.sqrt(np.sum((np.maximum(low - query, 0) + np.maximum(query - high, 0)) ** 2)))
 
 
-def bst_drawing(keys, left, right, query, neighbours, figsize=(9, 3.6)):
+def bst_drawing(keys, left, right, query, neighbours, offered=None, figsize=(9, 3.6)):
     """A binary search tree drawn with each node at (in-order rank, depth).
 
     The query's k nearest keys are marked, and every node whose key lies
     within the k-th distance of the query is outlined: a search must read
-    those, whatever its order.
+    those, whatever its order. The other nodes a search offered, if given,
+    are grey; the nodes it never read stay white.
 
     Parameters
     ----------
@@ -904,6 +914,8 @@ def bst_drawing(keys, left, right, query, neighbours, figsize=(9, 3.6)):
     query : float
     neighbours : array_like of int
         The k nearest nodes (ids).
+    offered : array_like of int, optional
+        The nodes a search offered to its result set.
     """
     import matplotlib.pyplot as plt
 
@@ -923,9 +935,17 @@ def bst_drawing(keys, left, right, query, neighbours, figsize=(9, 3.6)):
             if child >= 0:
                 ax.plot([rank[node], rank[child]], [-depth[node], -depth[child]], c="0.7", lw=1, zorder=1)
     must = np.abs(keys - query) <= w
-    ax.scatter(rank[~must], -depth[~must], s=120, c="white", edgecolors="0.5", zorder=2, label="farther than w")
-    ax.scatter(rank[must], -depth[must], s=120, c="white", edgecolors="tab:orange", lw=2, zorder=2,
-               label="within w of the query")  # fmt: skip
+    read = np.zeros(n, dtype=bool)
+    if offered is not None:
+        read[np.asarray(offered, dtype=int)] = True
+    face = np.where(read, "0.8", "white")
+    ax.scatter(rank[~must], -depth[~must], s=120, c=face[~must], edgecolors="0.5", zorder=2)
+    ax.scatter(rank[must], -depth[must], s=120, c=face[must], edgecolors="tab:orange", lw=2, zorder=2)
+    # The legend's entries, one per class, drawn empty (the nodes above mix the classes).
+    ax.scatter([], [], s=120, c="white", edgecolors="0.5", label="farther than w")
+    ax.scatter([], [], s=120, c="white", edgecolors="tab:orange", lw=2, label="within w of the query")
+    if offered is not None:
+        ax.scatter([], [], s=120, c="0.8", edgecolors="0.5", label="offered by the search")
     ax.scatter(rank[neighbours], -depth[neighbours], s=60, c="tab:orange", zorder=3, label="the k nearest")
     for node in range(n):
         ax.annotate(f"{keys[node]:g}", (rank[node], -depth[node]), xytext=(0, 9), textcoords="offset points",
@@ -979,6 +999,121 @@ def kdtree_partitions(panels, query, k, figsize=(11, 5.2), columns=None):
     plt.show()
 
 
+def kdtree_levels(points, tree, query=None, figsize=(11, 3.4)):
+    """A 2-D k-d tree's splits, one level more per panel; the last panel numbers the leaves.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+    tree : dict
+        A k-d tree of ``points`` in the layout of ``pcl_course.nn.kdtree_build``.
+    query : array_like of shape (2,), optional
+        Drawn as a star in the last panel.
+    """
+    import matplotlib.pyplot as plt
+
+    points = np.asarray(points, dtype=float)
+    lower, upper = points.min(axis=0), points.max(axis=0)
+    margin = 0.05 * (upper - lower).max()
+    lower, upper = lower - margin, upper + margin
+    segments = []  # (depth, axis, split, cell low, cell high) of every internal node
+    stack = [(0, 0, lower, upper)]
+    while stack:
+        node, depth, low, high = stack.pop()
+        axis = tree["axis"][node]
+        if axis < 0:
+            continue
+        split = tree["split"][node]
+        segments.append((depth, axis, split, low, high))
+        left_high, right_low = high.copy(), low.copy()
+        left_high[axis], right_low[axis] = split, split
+        stack += [(tree["left"][node], depth + 1, low, left_high), (tree["right"][node], depth + 1, right_low, high)]
+    levels = 1 + max((depth for depth, *_ in segments), default=-1)
+    fig, axes = plt.subplots(1, levels + 1, figsize=figsize, squeeze=False)
+    for panel, ax in enumerate(axes[0]):
+        for depth, axis, split, low, high in segments:
+            if depth < panel:
+                ends = ([split, split], [low[1], high[1]]) if axis == 0 else ([low[0], high[0]], [split, split])
+                ax.plot(*ends, c=f"C{depth}", lw=1.5)
+        ax.scatter(points[:, 0], points[:, 1], s=12, c="k", zorder=3)
+        ax.set(xlim=(lower[0], upper[0]), ylim=(lower[1], upper[1]), aspect="equal", xticks=[], yticks=[])
+        ax.set_title("the points" if panel == 0 else f"depth {panel - 1} splits", fontsize=9)
+    last = axes[0][-1]
+    last.set_title("leaves (node ids)", fontsize=9)
+    for node in np.flatnonzero(tree["axis"] < 0):
+        members = points[tree["order"][tree["start"][node] : tree["stop"][node]]]
+        last.annotate(str(node), members.mean(axis=0), textcoords="offset points", xytext=(0, 7), fontsize=8,
+                      ha="center", color="tab:red")  # fmt: skip
+    for index, (x, y) in enumerate(points):
+        axes[0][0].annotate(str(index), (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
+    if query is not None:
+        last.plot(*np.asarray(query, dtype=float), marker="*", c="tab:blue", ms=11, zorder=4)
+    plt.show()
+
+
+def quadtree_cells(points, tree, figsize=(6.5, 5.2)):
+    """The leaves of an octree of a flat (z = 0) cloud, seen from above as a quadtree, coloured by depth.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+    tree : dict
+        ``pcl_course.nn.octree_build`` of the points with a zero z column.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Rectangle
+
+    points = np.asarray(points, dtype=float)
+    depth = _octree_depths(tree)
+    leaves = np.flatnonzero(np.all(tree["children"] < 0, axis=1))
+    colours = plt.get_cmap("viridis", depth.max() + 1)
+    fig, ax = plt.subplots(figsize=figsize)
+    for node in leaves:
+        corner, side = tree["center"][node][:2] - tree["extent"][node], 2 * tree["extent"][node]
+        ax.add_patch(Rectangle(corner, side, side, fc=colours(depth[node]), alpha=0.35, ec="0.3", lw=0.5))
+    ax.scatter(points[:, 0], points[:, 1], s=1.5, c="k")
+    root = tree["center"][0][:2] - tree["extent"][0], 2 * tree["extent"][0]
+    ax.set(xlim=(root[0][0], root[0][0] + root[1]), ylim=(root[0][1], root[0][1] + root[1]), aspect="equal")
+    mappable = plt.cm.ScalarMappable(cmap=colours, norm=plt.Normalize(-0.5, depth.max() + 0.5))
+    fig.colorbar(mappable, ax=ax, label="depth of the leaf", ticks=range(depth.max() + 1))
+    plt.show()
+
+
+def _octree_depths(tree):
+    """Depth of every node of an octree in preorder (a parent before its children)."""
+    depth = np.zeros(len(tree["start"]), dtype=int)
+    for node, children in enumerate(tree["children"]):
+        depth[children[children >= 0]] = depth[node] + 1
+    return depth
+
+
+def octree_cubes_trace(tree, max_depth, color="gray", name=None, width=1):
+    """The edges of an octree's leaf cubes, and of its nodes at ``max_depth``, as one Plotly trace.
+
+    Parameters
+    ----------
+    tree : dict
+        As ``pcl_course.nn.octree_build`` returns.
+    max_depth : int
+        Deeper nodes are not drawn: their ancestor at this depth is.
+    """
+    import plotly.graph_objects as go
+
+    depth = _octree_depths(tree)
+    is_leaf = np.all(tree["children"] < 0, axis=1)
+    shown = np.flatnonzero((depth == max_depth) | (is_leaf & (depth < max_depth)))
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+    edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if np.sum(corners[a] != corners[b]) == 1]
+    segments = []
+    for node in shown:
+        cube = tree["center"][node] + tree["extent"][node] * corners
+        for a, b in edges:
+            segments += [cube[a], cube[b], [np.nan] * 3]  # NaN rows break the line between edges
+    segments = np.array(segments)
+    return go.Scatter3d(x=segments[:, 0], y=segments[:, 1], z=segments[:, 2], mode="lines", name=name,
+                        line=dict(color=color, width=width), hoverinfo="skip")  # fmt: skip
+
+
 def octant_tests(center, extent, balls, verdicts, figsize=(6.5, 5.2)):
     """One square cell (the 2-D picture of an octant) and query balls, each labelled with its verdicts.
 
@@ -1002,7 +1137,7 @@ def octant_tests(center, extent, balls, verdicts, figsize=(6.5, 5.2)):
     for (query, radius), verdict, color in zip(balls, verdicts, colors):
         ax.add_patch(Circle(query, radius, fill=False, ec=color, lw=2, label=verdict))
         ax.plot(*query, marker="o", c=color, ms=4)
-    reach = max(np.max(np.abs(np.asarray(q) - center)) + r for q, r in balls)
+    reach = 1.05 * max(np.max(np.abs(np.asarray(q) - center)) + r for q, r in balls)  # a margin: no line clipped
     ax.set(xlim=(center[0] - reach, center[0] + reach), ylim=(center[1] - reach, center[1] + reach), aspect="equal")
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
     plt.show()

@@ -6,7 +6,9 @@ then pastes nothing and warns, and the sentence reads "the error drops to
 mm". This wraps glue's text role (``{glue:text}``, in prose and captions):
 where it finds no value, it pastes a visible marker instead. It still emits
 myst-nb's warning, so the instructors' ``-W`` build still fails on a missing
-key.
+key; the students' release suppresses it (``mystnb.glue`` in its
+``suppress_warnings``): there a value is missing because an exercise is not
+done yet, and the marker says so without a warning per sentence.
 """
 
 from docutils import nodes

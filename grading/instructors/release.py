@@ -76,8 +76,16 @@ def _strip_solutions(markdown):
 def _student_config(text):
     # Cells of exercises a student has not done yet show "not implemented" instead of failing the build.
     text = substitute(text, "  allow_errors: false", "  allow_errors: true", "_config.yml")
-    return substitute(
+    text = substitute(
         text, "    nb_execution_raise_on_error: true", "    nb_execution_raise_on_error: false", "_config.yml"
+    )
+    # ... and a sentence whose number such a cell would give says so (book/_ext/missing_results.py),
+    # without a warning per sentence.
+    return substitute(
+        text,
+        'suppress_warnings: ["mystnb.unknown_mime_type"]',
+        'suppress_warnings: ["mystnb.unknown_mime_type", "mystnb.glue"]',
+        "_config.yml",
     )
 
 

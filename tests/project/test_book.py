@@ -192,3 +192,28 @@ def test_math_and_tables_render_on_every_page(name):
     assert not raw_math, f"{name}: a $ outside rendered math: {raw_math[:3]}"
     pipes = [line for line in text.splitlines() if line.count("|") >= 3]
     assert not pipes, f"{name}: a table left as text: {pipes[:2]}"
+
+
+@pytest.mark.parametrize("name", toc_files())
+def test_a_pages_title_is_its_own_heading(name):
+    """Issue 38: every lecture-2 page was titled "Lecture 1" (the browser tab, the search results)."""
+    html = page(name)
+    title = html_module.unescape(re.search(r"<title>(.*?)</title>", html, re.S).group(1))
+    heading = re.search(r"^# (.+)$", (REPO_ROOT / f"{name}.md").read_text(), re.M).group(1).strip()
+    site = yaml.safe_load((REPO_ROOT / "_config.yml").read_text())["title"]
+    shown = re.sub(r"^[\d.]+ ", "", title.split(" \u2014 ")[0])  # "12. k-d trees — site" -> "k-d trees"
+    assert shown == heading.replace("`", ""), f"{name}: titled {title!r}, its heading is {heading!r}"
+    assert title.endswith(f"\u2014 {site}"), f"{name}: titled {title!r}, not after the book ({site!r})"
+
+
+def test_the_outline_names_the_parts_of_the_table_of_contents():
+    """Issue 38: the outline called nearest neighbours "the next lecture" after it was in; it names
+    the parts it covers by their captions in _toc.yml, and every caption it quotes exists."""
+    captions = {part["caption"] for part in yaml.safe_load((REPO_ROOT / "_toc.yml").read_text())["parts"]}
+    outline = " ".join((REPO_ROOT / "book" / "outline.md").read_text().split())
+    quoted = set(re.findall(r'"([^"]+)"', outline))
+    assert quoted, "the outline quotes no part of the book"
+    assert quoted <= captions, f"the outline quotes parts that _toc.yml does not have: {sorted(quoted - captions)}"
+    lecture_parts = [caption for caption in captions if caption.startswith("Part ")]
+    assert set(lecture_parts) <= quoted, f"the outline does not say where {sorted(set(lecture_parts) - quoted)} is"
+    assert "next lecture" not in outline and "in progress" not in outline

@@ -84,7 +84,8 @@ def test_page_in_a_real_browser(name, site, browser):
         tab.evaluate("MathJax.startup.promise")
         assert tab.locator("mjx-container").count() > 0, f"{name}: math was not typeset"
 
-    # Nothing is cut at 1280 px: every table fits the text column, and every display
+    # Nothing is cut at 1280 px: every table fits the text column, every printed output's
+    # lines fit the cell (printed tables do not wrap, so a longer line is cut), and every display
     # equation fits its line (none needs the scroll bar the CSS gives as a last resort).
     cut = tab.evaluate(
         """() => {
@@ -94,6 +95,12 @@ def test_page_in_a_real_browser(name, site, browser):
             const box = table.getBoundingClientRect();
             if (box.right > column.right + 1 || table.parentElement.scrollWidth > table.parentElement.clientWidth + 1)
                 cut.push('table: ' + table.innerText.slice(0, 50));
+        }
+        for (const output of document.querySelectorAll('div.cell_output pre')) {
+            if (output.scrollWidth > output.clientWidth + 1) {
+                const longest = output.innerText.split('\\n').reduce((a, b) => (b.length > a.length ? b : a), '');
+                cut.push('printed line: ' + longest.slice(0, 80));
+            }
         }
         for (const equation of document.querySelectorAll('mjx-container[display="true"]')) {
             const box = equation.getBoundingClientRect();
@@ -137,3 +144,32 @@ def test_long_code_lines_wrap_and_legends_clear_the_mode_bar(site, browser):
     overlap_x = min(legend["x"] + legend["width"], modebar["x"] + modebar["width"]) - max(legend["x"], modebar["x"])
     overlap_y = min(legend["y"] + legend["height"], modebar["y"] + modebar["height"]) - max(legend["y"], modebar["y"])
     assert overlap_x <= 0 or overlap_y <= 0, f"the Plotly legend {legend} overlaps the mode bar {modebar}"
+
+
+def test_the_sidebars_open_on_a_phone_and_collapse_on_a_laptop(site, browser):
+    """Issue 38: with pydata-sphinx-theme 0.17.1 the buttons did nothing (they bound hidden twins),
+    so on a phone the chapter list could not be reached (book/_static/course.js)."""
+    phone = browser.new_page(viewport={"width": 390, "height": 844})
+    phone.goto(f"{site}/book/kdtree.html", wait_until="load")
+    for side in ("primary", "secondary"):
+        phone.locator(f".bd-header-article .{side}-toggle").click()
+        drawer = phone.locator(f"#pst-{side}-sidebar-modal")
+        drawer.wait_for(state="visible", timeout=STEP_BACKSTOP * 1000)
+        links = drawer.locator("a")
+        assert links.count() > 3 and links.first.is_visible(), f"the {side} drawer shows no links on a phone"
+        phone.keyboard.press("Escape")
+        drawer.wait_for(state="hidden", timeout=STEP_BACKSTOP * 1000)
+    phone.locator(".bd-header-article .primary-toggle").click()
+    phone.locator("#pst-primary-sidebar-modal a", has_text="Octree").first.click()  # a chapter, reached
+    phone.wait_for_url("**/octree.html", timeout=STEP_BACKSTOP * 1000)
+    phone.close()
+
+    laptop = browser.new_page(viewport={"width": 1280, "height": 900})
+    laptop.goto(f"{site}/book/kdtree.html", wait_until="load")
+    sidebar = laptop.locator("#pst-primary-sidebar")
+    assert sidebar.is_visible()
+    laptop.locator(".bd-header-article .primary-toggle").click()
+    sidebar.wait_for(state="hidden", timeout=STEP_BACKSTOP * 1000)
+    laptop.locator(".bd-header-article .primary-toggle").click()
+    sidebar.wait_for(state="visible", timeout=STEP_BACKSTOP * 1000)
+    laptop.close()

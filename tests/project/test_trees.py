@@ -60,15 +60,17 @@ def test_a_lying_tree_keeps_the_rules_answer_and_fools_brute_force(rng):
             assert set(trees.brute_knn(lying, query, 4)[0]) <= set(decoys)  # brute force is
 
 
-@pytest.mark.parametrize("balanced", [True, False])
+@pytest.mark.parametrize(
+    "balanced, compact", [(True, True), (False, True), (False, False)], ids=["median", "midpoint", "sliding"]
+)
 @pytest.mark.parametrize("name", ["uniform", "duplicates", "flat 2-D"])
-def test_scipy_trees_in_the_course_layout_are_valid_trees_that_search_right(name, balanced, rng):
+def test_scipy_trees_in_the_course_layout_are_valid_trees_that_search_right(name, balanced, compact, rng):
     """The book's split-rule comparison searches SciPy's trees with the course's own search."""
     from pcl_course.neighbors import scipy_kdtree
     from pcl_course.validation import check_kdtree
 
     points = CLOUDS[name](rng)
-    tree = scipy_kdtree(points, 8, balanced_tree=balanced)
+    tree = scipy_kdtree(points, 8, balanced_tree=balanced, compact_nodes=compact)
     check_kdtree(tree, len(points), points.shape[1])
     for node in np.flatnonzero(tree["axis"] >= 0):
         axis, split = tree["axis"][node], tree["split"][node]
