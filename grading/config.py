@@ -85,8 +85,8 @@ DIAGNOSIS_BUDGET = 64 * 1024**2
 # took the grading process from 0.86 to 1.4 GiB by the collector's timing alone).
 COLLECT_EVERY_BYTES = 64 * 1024**2
 # Wall-clock seconds of one submission's whole grading: tests not started by
-# then score 0 with a line that says so (a test under way may add its own
-# TEST_TIMEOUT), within Gradescope's default limit of 10 minutes.
+# then score 0 with a line that says so, and a test under way when it runs out
+# stops there (a hard deadline), within Gradescope's default limit of 10 minutes.
 SUBMISSION_BUDGET = 480.0
 
 # -- the worker process (grading/sandbox/) ----------------------------------

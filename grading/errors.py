@@ -110,6 +110,9 @@ class TestTimeout(Exception):
 
     __test__ = False  # not a test class, whatever pytest collects
 
-    def __init__(self, seconds):
-        super().__init__(f"timed out: the test ran for more than {seconds:g} s")
-        self.seconds = seconds
+    def __init__(self, seconds, budget=None):
+        if budget is None:
+            super().__init__(f"timed out: the test ran for more than {seconds:g} s")
+        else:
+            super().__init__(f"timed out: the submission's time budget of {budget:g} s ran out during this test")
+        self.seconds, self.budget = seconds, budget

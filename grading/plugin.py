@@ -277,9 +277,15 @@ def _report_progress(config, result):
         config.stash[_PROGRESS_KEY] = None
 
 
-def _over_budget(config):
+def _remaining_budget(config):
+    """Seconds left of the submission's time budget (None before the first graded test)."""
     started = config.stash.get(_STARTED_KEY, None)
-    return started is not None and time.monotonic() - started > config.getoption("--budget")
+    return None if started is None else config.getoption("--budget") - (time.monotonic() - started)
+
+
+def _over_budget(config):
+    remaining = _remaining_budget(config)
+    return remaining is not None and remaining < 0
 
 
 def pytest_runtest_call(item):
@@ -298,12 +304,20 @@ def pytest_timeout_set_timer(item, settings):
     a timeout is known by its class, never by the words of a message."""
     if not _is_graded(item) or settings.timeout <= 0:
         return None  # pytest-timeout's own timer
+    # The submission's budget is a hard deadline: a test under way when it runs out stops
+    # there. Otherwise a test started just before it could run on for its whole limit, and
+    # the grading's end (inside Gradescope's limit or past it) would be one bit chosen by the
+    # submission after it has seen hidden inputs (issue 35's hostile review).
+    remaining = _remaining_budget(item.config)
+    limit, budget = settings.timeout, None
+    if remaining is not None and remaining < limit:
+        limit, budget = max(remaining, 0.01), item.config.getoption("--budget")
 
     def expire(signum, frame):
-        raise TestTimeout(settings.timeout)
+        raise TestTimeout(settings.timeout, budget=budget)
 
     item.stash[_ALARM_KEY] = signal.signal(signal.SIGALRM, expire)
-    signal.setitimer(signal.ITIMER_REAL, settings.timeout)
+    signal.setitimer(signal.ITIMER_REAL, limit)
     return True
 
 

@@ -195,7 +195,7 @@ class Grading:
         if self.note:
             parts.append(fenced(self.note))
         if self.isolation:
-            parts.append(self.isolation)
+            parts.append(fenced(self.isolation))  # it may name a folder of the student's choosing: never markup
         score = sum(t.score for t in public)
         maximum = sum(t.max_score for t in public)
         heading = f"**Public tests: {score:g} / {maximum:g} points.**"

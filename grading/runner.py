@@ -15,6 +15,7 @@ import threading
 
 from grading import GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT
 from grading.options import pytest_arguments
+from grading.results import clean
 
 PYTEST_EXIT_NO_TESTS = 5
 PYTEST_EXIT_USAGE = 4
@@ -89,16 +90,28 @@ def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None,
             listener.start()
         output, _ = process.communicate()
         if listener is not None:
-            listener.join()
+            # A process the grading left behind may hold the pipe open (an ungraded, not isolated
+            # run gives the submission the grader's own user): progress is a courtesy, never a wait.
+            listener.join(timeout=PROGRESS_DRAIN)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     return process.returncode, output
 
 
+PROGRESS_DRAIN = 2.0  # seconds to wait, once grading has ended, for the progress pipe's last lines
+
+
 def _relay_progress(reader, progress):
-    """Call ``progress`` for each line of the grading process's progress pipe, until it closes."""
-    with os.fdopen(reader) as lines:
+    """Call ``progress`` for each line of the grading process's progress pipe, until it closes.
+
+    The lines come from the grading process (``counts seconds test score``); a line that is not
+    of that form is skipped, and the test's name is cleaned of control characters: where the
+    run is not isolated, the submission runs as the grader's user and could write to the pipe."""
+    with os.fdopen(reader, errors="replace") as lines:
         for line in lines:
-            counts, seconds, test, score = line.split()
-            done, total = counts.split("/")
-            progress(int(done), int(total), float(seconds), test, score)
+            try:
+                counts, seconds, test, score = line.split()
+                done, total = (int(n) for n in counts.split("/"))
+                progress(done, total, float(seconds), clean(test, limit=200, newlines=False), clean(score, limit=20))
+            except ValueError:
+                continue

@@ -107,5 +107,7 @@ def check(name, assignment=None):
             lines = (completed.stderr or completed.stdout).strip().splitlines()
             raise RuntimeError(lines[-1] if lines else f"the grader exited with status {completed.returncode}")
         report = json.loads(results.read_text())
-    table = completed.stdout.split("Results written to")[0].rstrip()
+    # The grader's last line names the results file; a test's feedback above it may quote the
+    # submission, "Results written to" included, so the table ends at the last such line.
+    table = completed.stdout.rsplit("\nResults written to", 1)[0].rstrip()
     return CheckReport(report, table)

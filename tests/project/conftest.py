@@ -21,11 +21,12 @@ def pytest_collection_modifyitems(items):
 
 
 @pytest.fixture(autouse=True)
-def own_temporary_folder(monkeypatch):
+def own_temporary_folder(monkeypatch, tmp_path_factory):
     """Every temporary folder a test makes in this process (a staged submission, a grading's
     options) goes into a folder of its own, removed after the test: a test that stages a
     submission for a worker of its own never leaves it in /tmp. Mode 0711, as /tmp's
     sticky folder is traversable: a worker of another uid reaches the staged root below it."""
+    tmp_path_factory.getbasetemp()  # pytest's own folder first, where it always is (it is made lazily)
     folder = tempfile.mkdtemp(prefix="pcl-test-")
     Path(folder).chmod(0o711)
     monkeypatch.setattr(tempfile, "tempdir", folder)

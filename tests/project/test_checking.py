@@ -42,3 +42,24 @@ def test_check_in_a_terminal_is_the_graders_table_and_selects_a_module_or_a_lect
 def test_check_refuses_a_name_that_is_not_the_courses(name, assignment, message):
     with pytest.raises(ValueError, match=message):
         pcl_course.check(name, assignment)
+
+
+def test_feedback_that_quotes_the_results_line_does_not_cut_the_table(monkeypatch):
+    """Issue 37's hostile review: an exception message holding "Results written to" ended the
+    terminal table there, hiding the real total behind a forged one."""
+    import json
+    import subprocess
+    from pathlib import Path
+
+    from pcl_course import checking
+
+    forged = "  test_x: raised ValueError: x\n\nTotal: 7 / 7\n\nResults written to /dev/null"
+    stdout = f"Grading here\n{forged}\nTotal: 0 / 7\nisolated: test\nResults written to /tmp/r.json\n"
+
+    def run(command, **kwargs):
+        Path(command[command.index("--results") + 1]).write_text(json.dumps({"score": 0, "tests": []}))
+        return subprocess.CompletedProcess(command, 0, stdout=stdout, stderr="")
+
+    monkeypatch.setattr(checking.subprocess, "run", run)
+    table = repr(checking.check("fit_plane"))
+    assert table.endswith("Total: 0 / 7\nisolated: test") and "Total: 7 / 7" in table

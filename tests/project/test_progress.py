@@ -74,3 +74,19 @@ def test_batch_prints_a_line_as_each_submission_finishes_on_a_terminal(tmp_path)
     assert sorted(done for done, *_ in lines) == ["1", "2"] and {name for _, name, *_ in lines} == {"ann", "ben"}
     quiet = run([*argv, "--quiet", "--out", str(tmp_path / "quiet")], terminal=True)
     assert not re.search(r"\[\d/2\]", quiet) and re.search(r"^ann: \d+ / \d+\r?$", quiet, re.M), quiet
+
+
+def test_the_relay_skips_lines_not_of_its_form_and_cleans_test_names():
+    """Issue 37's hostile review: where a run is not isolated, a submission could write to the progress
+    pipe; a malformed line killed the relay and a name with escapes reached the terminal."""
+    import os
+
+    from grading.runner import _relay_progress
+
+    reader, writer = os.pipe()
+    os.write(writer, b"garbage\n1/2 3 test_a\x1b]0;TITLE\x07 2/2\n2/2 4 test_b 1/1\n\xff\xfe\n")
+    os.close(writer)
+    seen = []
+    _relay_progress(reader, lambda *line: seen.append(line))
+    assert [line[0] for line in seen] == [1, 2]
+    assert "\x1b" not in seen[0][3] and "\x07" not in seen[0][3]
