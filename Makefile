@@ -51,8 +51,18 @@ lint: setup
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
-test: lint book notebooks
-	$(BIN)/python -m pytest -n auto --durations=20
+# The book's build executes its pages one at a time, on one core: the tests that do
+# not read the built book run beside it, then the book's own checks and nbval.
+test: lint $(CODE_STAMP) $(NUMBA_STAMP)
+	@mkdir -p _build
+	@echo "Building the book (log: _build/book.log) while the tests that do not need it run"
+	{ $(BIN)/jupyter-book build . -W -n --keep-going > _build/book.log 2>&1; echo $$? > _build/book.status; } & \
+	$(BIN)/python -m pytest -n auto --durations=20 -m "not book"; tests=$$?; \
+	wait; tail -n 5 _build/book.log; \
+	if [ "$$(cat _build/book.status)" != 0 ]; then cat _build/book.log; echo "make test: the book's build failed"; exit 1; fi; \
+	if [ $$tests != 0 ]; then echo "make test: tests failed"; exit 1; fi
+	$(MAKE) --no-print-directory notebooks
+	$(BIN)/python -m pytest -n auto -m book
 	$(BIN)/python -m pytest -n auto --dist loadfile --nbval-lax _build/notebooks
 
 # tests/images: debootstrap roots of the distributions, run with bwrap (README
