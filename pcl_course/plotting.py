@@ -941,11 +941,13 @@ def bst_drawing(keys, left, right, query, neighbours, offered=None, figsize=(9, 
     face = np.where(read, "0.8", "white")
     ax.scatter(rank[~must], -depth[~must], s=120, c=face[~must], edgecolors="0.5", zorder=2)
     ax.scatter(rank[must], -depth[must], s=120, c=face[must], edgecolors="tab:orange", lw=2, zorder=2)
-    # The legend's entries, one per class, drawn empty (the nodes above mix the classes).
-    ax.scatter([], [], s=120, c="white", edgecolors="0.5", label="farther than w")
-    ax.scatter([], [], s=120, c="white", edgecolors="tab:orange", lw=2, label="within w of the query")
+    # The legend's entries, one per class, drawn empty (the nodes above mix the classes): the
+    # outline says where a key lies, the fill what the search did with it.
+    ax.scatter([], [], s=120, facecolors="none", edgecolors="0.5", label="outline: farther than w")
+    ax.scatter([], [], s=120, facecolors="none", edgecolors="tab:orange", lw=2, label="outline: within w")
     if offered is not None:
-        ax.scatter([], [], s=120, c="0.8", edgecolors="0.5", label="offered by the search")
+        ax.scatter([], [], s=120, c="0.8", edgecolors="none", label="grey: offered by the search")
+        ax.scatter([], [], s=120, c="white", edgecolors="0.8", label="white: not read")
     ax.scatter(rank[neighbours], -depth[neighbours], s=60, c="tab:orange", zorder=3, label="the k nearest")
     for node in range(n):
         ax.annotate(f"{keys[node]:g}", (rank[node], -depth[node]), xytext=(0, 9), textcoords="offset points",
@@ -1040,15 +1042,17 @@ def kdtree_levels(points, tree, query=None, figsize=(11, 3.4)):
         ax.set_title("the points" if panel == 0 else f"depth {panel - 1} splits", fontsize=9)
     last = axes[0][-1]
     last.set_title("leaves (node ids)", fontsize=9)
-    for node in np.flatnonzero(tree["axis"] < 0):
-        members = points[tree["order"][tree["start"][node] : tree["stop"][node]]]
-        last.annotate(str(node), members.mean(axis=0), textcoords="offset points", xytext=(0, 7), fontsize=8,
-                      ha="center", color="tab:red")  # fmt: skip
+    for node, (low, high) in kdtree_leaf_cells(tree, lower, upper).items():  # a leaf's id at its cell's centre
+        last.annotate(str(node), (low + high) / 2, fontsize=8, ha="center", va="center", color="tab:red",
+                      bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.8))  # fmt: skip
     for index, (x, y) in enumerate(points):
         axes[0][0].annotate(str(index), (x, y), textcoords="offset points", xytext=(4, 3), fontsize=7)
     if query is not None:
         last.plot(*np.asarray(query, dtype=float), marker="*", c="tab:blue", ms=11, zorder=4)
     plt.show()
+
+
+FILL_ALPHA = 0.35  # the quadtree's squares, see-through over the points (the colour bar matches it)
 
 
 def quadtree_cells(points, tree, figsize=(6.5, 5.2)):
@@ -1070,12 +1074,12 @@ def quadtree_cells(points, tree, figsize=(6.5, 5.2)):
     fig, ax = plt.subplots(figsize=figsize)
     for node in leaves:
         corner, side = tree["center"][node][:2] - tree["extent"][node], 2 * tree["extent"][node]
-        ax.add_patch(Rectangle(corner, side, side, fc=colours(depth[node]), alpha=0.35, ec="0.3", lw=0.5))
+        ax.add_patch(Rectangle(corner, side, side, fc=colours(depth[node]), alpha=FILL_ALPHA, ec="0.3", lw=0.5))
     ax.scatter(points[:, 0], points[:, 1], s=1.5, c="k")
     root = tree["center"][0][:2] - tree["extent"][0], 2 * tree["extent"][0]
     ax.set(xlim=(root[0][0], root[0][0] + root[1]), ylim=(root[0][1], root[0][1] + root[1]), aspect="equal")
     mappable = plt.cm.ScalarMappable(cmap=colours, norm=plt.Normalize(-0.5, depth.max() + 0.5))
-    fig.colorbar(mappable, ax=ax, label="depth of the leaf", ticks=range(depth.max() + 1))
+    fig.colorbar(mappable, ax=ax, label="depth of the leaf", ticks=range(depth.max() + 1), alpha=FILL_ALPHA)
     plt.show()
 
 
