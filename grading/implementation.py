@@ -144,7 +144,7 @@ class Implementation:
         self.overrides = {k: Path(v).resolve() for k, v in (overrides or {}).items()}
         self.package = f"_graded_impl_{next(_counter)}"
         self._modules = {}
-        self.last_call = None
+        self._last_call, self._last_call_text = None, None
         self.last_modified = []  # names of the arguments the last call modified in place
         self.sandboxed = sandbox
         self.current_test = None  # set by the plugin: the test under way
@@ -228,7 +228,7 @@ class Implementation:
                 return _call_on_copies(loaded, args, kwargs)
 
         def graded_call(*args, **kwargs):
-            self.last_call = describe_call(name, args, kwargs)
+            self._last_call, self._last_call_text = (name, args, kwargs), None
             self.last_modified, modified = [], []
             self.recorder.collect_if_due()
             kept = self.recorder.snapshot(args, kwargs)
@@ -263,6 +263,17 @@ class Implementation:
 
         graded_call.__name__ = name
         return graded_call
+
+    @property
+    def last_call(self):
+        """The last call, described for feedback (``pca(<array (100, 3) float64>)``), or None.
+
+        Described when asked, at a failure: formatting every call's arrays cost a
+        correct submission's grading a tenth of its time. The arguments are the
+        test's own, which no call modifies (the function works on copies)."""
+        if self._last_call is not None:
+            self._last_call_text, self._last_call = describe_call(*self._last_call), None
+        return self._last_call_text
 
     def source(self, module):
         """The text of the implementation's ``module.py`` (read, never run), or None."""

@@ -83,6 +83,12 @@ def fenced(text, info="text"):
     return f"{fence}{info}\n{text}\n{fence}"
 
 
+def markdown_escaped(text):
+    """``text`` as literal Markdown: every character that could start markup (a tag, a link,
+    emphasis, code, a table) escaped with a backslash, as CommonMark allows for punctuation."""
+    return re.sub(r"([\\`*_\[\]<>&!|~#])", r"\\\1", text)
+
+
 def cap_lines(text, lines=MAX_OUTPUT_LINES, limit=MAX_OUTPUT):
     """At most ``lines`` lines and ``limit`` characters of ``text``, saying what was cut."""
     kept = text.splitlines()
@@ -195,7 +201,7 @@ class Grading:
         if self.note:
             parts.append(fenced(self.note))
         if self.isolation:
-            parts.append(fenced(self.isolation))  # it may name a folder of the student's choosing: never markup
+            parts.append(markdown_escaped(self.isolation))  # it may name a folder a student chose: never markup
         score = sum(t.score for t in public)
         maximum = sum(t.max_score for t in public)
         heading = f"**Public tests: {score:g} / {maximum:g} points.**"

@@ -178,18 +178,19 @@ def bst(keys, drop_equal=False):
     on its path is not inserted (its node is left with no parent).
     """
     n = len(keys)
-    left, right = np.full(n, -1, dtype=np.int64), np.full(n, -1, dtype=np.int64)
+    values = np.asarray(keys).tolist()  # plain Python: a sorted input's path costs N^2 / 2 steps
+    left, right = [-1] * n, [-1] * n
     for i in range(1, n):
-        node = 0
+        node, key = 0, values[i]
         while True:
-            if drop_equal and keys[i] == keys[node]:
+            if drop_equal and key == values[node]:
                 break
-            links = left if keys[i] < keys[node] else right
+            links = left if key < values[node] else right
             if links[node] < 0:
                 links[node] = i
                 break
             node = links[node]
-    return left, right
+    return np.array(left, dtype=np.int64), np.array(right, dtype=np.int64)
 
 
 def kdtree(

@@ -164,3 +164,16 @@ def test_batch_in_the_uid_mode_refuses_a_class_folder_the_sandbox_can_read(tmp_p
         cli.main(["batch", str(classroom), "--assignment", "lecture1", "--out", str(tmp_path / "out")])
     assert "refusing to grade the class" in str(refused.value) and f"chmod 700 {classroom}" in str(refused.value)
     assert os.stat(tmp_path / "out").st_mode & 0o777 == 0o700  # the results folder: the grader's only
+
+
+def test_the_isolation_line_is_never_markup_in_the_summary():
+    """Issue 37's hostile review: a clone's folder named ``<img src=x onerror=...>`` reached the
+    Markdown summary through the isolation line (which names the folder where a run is not isolated)."""
+    import markdown_it
+
+    from grading.results import Grading
+
+    grading = Grading(isolation="NOT ISOLATED (the worker can read /tmp/<img src=x onerror=alert(1)>/c *a* [l](u))")
+    html = markdown_it.MarkdownIt().render(grading.summary_markdown())
+    assert "<img" not in html and "<a " not in html and "<em>" not in html
+    assert "&lt;img src=x onerror=alert(1)&gt;" in html
