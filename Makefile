@@ -51,19 +51,21 @@ lint: setup
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 
-# The book's build executes its pages one at a time, on one core: the tests that do
-# not read the built book run beside it, then the book's own checks and nbval.
-test: lint $(CODE_STAMP) $(NUMBA_STAMP)
-	@mkdir -p _build
-	@echo "Building the book (log: _build/book.log) while the tests that do not need it run"
+# The book's build and nbval execute pages one at a time, each on one core, and many
+# project tests wait on a subprocess: the three run side by side, the project's tests
+# that do not read the built book on three workers (README "Tests"), then the book's
+# own checks. Every limit of the tests is CPU time, or a wall-clock backstop far above it.
+test: lint notebooks $(CODE_STAMP) $(NUMBA_STAMP)
+	@echo "Building the book (_build/book.log) and running nbval (_build/nbval.log) beside the tests"
 	{ $(BIN)/jupyter-book build . -W -n --keep-going > _build/book.log 2>&1; echo $$? > _build/book.status; } & \
-	$(BIN)/python -m pytest -n auto --durations=20 -m "not book"; tests=$$?; \
-	wait; tail -n 5 _build/book.log; \
+	{ $(BIN)/python -m pytest -p no:xdist --nbval-lax _build/notebooks > _build/nbval.log 2>&1; \
+	  echo $$? > _build/nbval.status; } & \
+	$(BIN)/python -m pytest -n 3 --durations=20 -m "not book"; tests=$$?; \
+	wait; tail -n 3 _build/nbval.log; \
 	if [ "$$(cat _build/book.status)" != 0 ]; then cat _build/book.log; echo "make test: the book's build failed"; exit 1; fi; \
+	if [ "$$(cat _build/nbval.status)" != 0 ]; then cat _build/nbval.log; echo "make test: nbval failed"; exit 1; fi; \
 	if [ $$tests != 0 ]; then echo "make test: tests failed"; exit 1; fi
-	$(MAKE) --no-print-directory notebooks
 	$(BIN)/python -m pytest -n auto -m book
-	$(BIN)/python -m pytest -n auto --dist loadfile --nbval-lax _build/notebooks
 
 # tests/images: debootstrap roots of the distributions, run with bwrap (README
 # "Environments"). About 10 minutes; the roots are kept in build/images.
