@@ -1,5 +1,6 @@
 """Fixtures of the project's tests."""
 
+import fcntl
 import shutil
 import tempfile
 import zlib
@@ -7,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _helpers import TEST_BACKSTOP, run_grader
+from _helpers import TEST_BACKSTOP, load_results, run_grader
 
 PROJECT_TESTS = Path(__file__).parent
 
@@ -42,6 +43,18 @@ def rng(request):
 
 
 @pytest.fixture(scope="session")
-def reference_grading(tmp_path_factory):
-    """The grader's verdict on the reference solutions, run once per session."""
-    return run_grader("--reference", tmp_path=tmp_path_factory.mktemp("reference"))
+def reference_grading(tmp_path_factory, request):
+    """The grader's verdict on the reference solutions, run once per test run.
+
+    Under xdist the first worker that needs it grades; the others wait on a lock and read its
+    results file (the workers share their basetemp's parent, which is this run's own)."""
+    if not hasattr(request.config, "workerinput"):  # not an xdist worker: this run alone
+        return run_grader("--reference", tmp_path=tmp_path_factory.mktemp("reference"))
+    shared = tmp_path_factory.getbasetemp().parent / "reference-grading"
+    shared.mkdir(exist_ok=True)
+    with open(shared / "lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not (shared / "stdout.txt").exists():
+            _, stdout = run_grader("--reference", tmp_path=shared)
+            (shared / "stdout.txt").write_text(stdout)
+    return load_results(shared / "results.json"), (shared / "stdout.txt").read_text()
