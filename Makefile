@@ -53,14 +53,14 @@ lint: setup
 
 # The book's build and nbval execute pages one at a time, each on one core, and many
 # project tests wait on a subprocess: the three run side by side, the project's tests
-# that do not read the built book on four workers (README "Tests"), then the book's
+# that do not read the built book on three workers (README "Tests"), then the book's
 # own checks. Every limit of the tests is CPU time, or a wall-clock backstop far above it.
 test: lint notebooks $(CODE_STAMP) $(NUMBA_STAMP)
 	@echo "Building the book (_build/book.log) and running nbval (_build/nbval.log) beside the tests"
 	{ $(BIN)/jupyter-book build . -W -n --keep-going > _build/book.log 2>&1; echo $$? > _build/book.status; } & \
 	{ $(BIN)/python -m pytest -p no:xdist --nbval-lax _build/notebooks > _build/nbval.log 2>&1; \
 	  echo $$? > _build/nbval.status; } & \
-	$(BIN)/python -m pytest -n 4 --durations=20 -m "not book"; tests=$$?; \
+	$(BIN)/python -m pytest -n 3 --durations=20 -m "not book"; tests=$$?; \
 	wait; tail -n 3 _build/nbval.log; \
 	if [ "$$(cat _build/book.status)" != 0 ]; then cat _build/book.log; echo "make test: the book's build failed"; exit 1; fi; \
 	if [ "$$(cat _build/nbval.status)" != 0 ]; then cat _build/nbval.log; echo "make test: nbval failed"; exit 1; fi; \
