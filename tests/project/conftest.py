@@ -15,10 +15,15 @@ PROJECT_TESTS = Path(__file__).parent
 
 def pytest_collection_modifyitems(items):
     """Every project test without its own ``timeout`` marker gets the wall-clock backstop
-    (``tests/_helpers.py``); graded tests keep the grader's (grading.config.TEST_TIMEOUT)."""
+    (``tests/_helpers.py``); graded tests keep the grader's (grading.config.TEST_TIMEOUT).
+
+    Tests marked ``long`` come first, in their order (a stable sort, the same in every xdist
+    worker): xdist deals the first tests out in turn, so the long ones start at once on
+    every worker instead of ending the run on one while the others are idle."""
     for item in items:
         if item.path.is_relative_to(PROJECT_TESTS) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(TEST_BACKSTOP))
+    items.sort(key=lambda item: item.get_closest_marker("long") is None)
 
 
 @pytest.fixture(autouse=True)

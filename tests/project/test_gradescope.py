@@ -99,6 +99,7 @@ def test_the_archive_has_gradescope_layout_and_no_reference_code(archive, tmp_pa
     assert find_leaks(tmp_path)
 
 
+@pytest.mark.long
 def test_the_reference_uploaded_as_a_repository_gets_full_marks(archive, tmp_path):
     root = autograder_root(archive, tmp_path / "autograder")
     reference_package(root / "submission" / "my-repo" / "pcl_course")

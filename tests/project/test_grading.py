@@ -230,6 +230,18 @@ def _batch_ids(batches):
     ]
 
 
+# Modules whose grading takes a minute or so a batch under make test's load (lecture 2's structure
+# tests build lying trees and replay the catalogue's searches): their batches are collected first.
+LONG_MODULES = ("nn",)
+
+
+def _batch_params(batches):
+    return [
+        pytest.param(batch, id=name, marks=[pytest.mark.long] if _module_of(batch[0]) in LONG_MODULES else [])
+        for batch, name in zip(batches, _batch_ids(batches))
+    ]
+
+
 def grade_together(files, tmp_path, *extra):
     """Grade one file per function of one module at once: a generated module takes each function from its file."""
     module = _module_of(files[0])
@@ -328,7 +340,7 @@ def check_wrong_submission(mutant, summary):
 MUTANT_BATCHES = _batches(MUTANTS)
 
 
-@pytest.mark.parametrize("mutants", MUTANT_BATCHES, ids=_batch_ids(MUTANT_BATCHES))
+@pytest.mark.parametrize("mutants", _batch_params(MUTANT_BATCHES))
 def test_wrong_submission_loses_points_and_gets_its_diagnosis(mutants, tmp_path):
     summary = grade_together(mutants, tmp_path)
     for mutant in mutants:
@@ -348,7 +360,7 @@ def test_each_lectures_mutants_are_named_by_their_diagnosis(assignment):
 ALTERNATIVE_BATCHES = _batches(ALTERNATIVES)
 
 
-@pytest.mark.parametrize("variants", ALTERNATIVE_BATCHES, ids=_batch_ids(ALTERNATIVE_BATCHES))
+@pytest.mark.parametrize("variants", _batch_params(ALTERNATIVE_BATCHES))
 def test_other_correct_submission_gets_full_marks_and_no_diagnosis(variants, tmp_path):
     # --diagnose-always: the catalogue is tried on this full-marks run as if every test had failed.
     summary = grade_together(variants, tmp_path, "--diagnose-always")
@@ -595,6 +607,7 @@ def test_a_killed_run_leaves_valid_partial_results(tmp_path):
     assert summary["score"] == sum(t["score"] for t in summary["tests"])
 
 
+@pytest.mark.long
 def test_a_hidden_structure_test_tells_a_decoy_read_from_points_lost(tmp_path):
     """A lying tree fails both a search that reads too much and one that loses points; its one line tells
     which (a planted point in the answer, or none), so a student who lost points is not sent after pruning."""

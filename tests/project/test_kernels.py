@@ -356,6 +356,7 @@ CHECKED_RUN = [
 
 
 # About 85 s on an idle machine during make test (numba compiles every kernel again, checked).
+@pytest.mark.long
 @pytest.mark.timeout(backstop(300))
 @pytest.mark.skipif(bool(numba.config.BOUNDSCHECK), reason="runs the checked run; not inside it")
 def test_the_kernel_tests_pass_bounds_checked(tmp_path):

@@ -376,6 +376,7 @@ def test_the_release_grades_its_stubs_at_zero_without_an_error(release_dir):
     assert f"Hidden tests carry {sum(hidden.values()):g} more points of these functions" in completed.stdout
 
 
+@pytest.mark.long
 def test_the_release_book_builds_with_the_stubs(release_dir):
     # The release's own pcl_course first on the path: the kernel must run the
     # stubs, as in a student's fresh environment (where no solutions exist).

@@ -209,6 +209,7 @@ def make_clone(tmp_path, replace=None):
     return clone
 
 
+@pytest.mark.long
 def test_an_infinite_loop_costs_only_its_tests(tmp_path):
     source = reference_source("normals").replace(
         "def fit_plane(points, weights=None):\n",

@@ -130,6 +130,7 @@ def per_function(results):
     return totals
 
 
+@pytest.mark.long
 def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     """For every graded function: answers computed on a rewritten input score no more when the
     call also writes that input into the grader's arrays (the grader computes from a frozen copy)."""
