@@ -147,18 +147,23 @@ def _squared(points, indices, query):
     return ((points[indices] - query) ** 2).sum(axis=1)
 
 
-def _knn(tree, points, queries, k, own_leaf, width, mutual=False):
-    points = np.asarray(points, dtype=float)[:, :width]
-    rows, dists = [], []
-    shared = _mutual_kept(tree, points) if mutual is True else None  # the same for every query
-    in_cell = _inside_their_leaf(tree, points) if not mutual else None  # the same for every query
-    for query in np.asarray(queries, dtype=float)[:, :width]:
+def _kept_per_query(tree, points, queries, own_leaf, mutual):
+    """``(query, kept)`` for each query: what is the same for every query is computed once."""
+    shared = _mutual_kept(tree, points) if mutual is True else None
+    in_cell = _inside_their_leaf(tree, points) if not mutual else None
+    for query in queries:
         if shared is not None:
-            kept = shared
+            yield query, shared
         elif in_cell is not None:
-            kept = _kept(tree, in_cell, query, own_leaf)
+            yield query, _kept(tree, in_cell, query, own_leaf)
         else:
-            kept = kept_by_cell(tree, points, query, own_leaf, mutual)
+            yield query, kept_by_cell(tree, points, query, own_leaf, mutual)
+
+
+def _knn(tree, points, queries, k, own_leaf, width, mutual=False):
+    points, queries = np.asarray(points, dtype=float)[:, :width], np.asarray(queries, dtype=float)[:, :width]
+    rows, dists = [], []
+    for query, kept in _kept_per_query(tree, points, queries, own_leaf, mutual):
         s = _squared(points, kept, query)
         rank = np.lexsort((kept, s))[:k]
         rows.append(kept[rank])
@@ -167,17 +172,9 @@ def _knn(tree, points, queries, k, own_leaf, width, mutual=False):
 
 
 def _radius(tree, points, queries, radius, own_leaf, width, mutual=False):
-    points = np.asarray(points, dtype=float)[:, :width]
+    points, queries = np.asarray(points, dtype=float)[:, :width], np.asarray(queries, dtype=float)[:, :width]
     rows, dists = [], []
-    shared = _mutual_kept(tree, points) if mutual is True else None  # the same for every query
-    in_cell = _inside_their_leaf(tree, points) if not mutual else None  # the same for every query
-    for query in np.asarray(queries, dtype=float)[:, :width]:
-        if shared is not None:
-            kept = shared
-        elif in_cell is not None:
-            kept = _kept(tree, in_cell, query, own_leaf)
-        else:
-            kept = kept_by_cell(tree, points, query, own_leaf, mutual)
+    for query, kept in _kept_per_query(tree, points, queries, own_leaf, mutual):
         s = _squared(points, kept, query)
         inside = s <= radius**2
         rank = np.lexsort((kept[inside], s[inside]))
