@@ -7,6 +7,7 @@ student's own ``pcl_course`` code.
 """
 
 import importlib
+import importlib.util
 import time
 from pathlib import Path
 
@@ -14,7 +15,7 @@ import numpy as np
 
 from pcl_course.validation import check_choice, check_integer
 
-__all__ = ["implementation", "wall_time"]
+__all__ = ["implementation", "timed_queries", "wall_time"]
 
 # Where the reference solutions live in the instructors' repository; the
 # student release sets it to None (it ships no solutions).
@@ -32,6 +33,45 @@ def implementation(module):
                 raise
     _show_stubs_briefly()
     return importlib.import_module(f"pcl_course.{module}")
+
+
+def _runs_the_reference():
+    """Whether the book runs the reference solutions (the course's own build), not a student's code."""
+    if not REFERENCE_PACKAGE:
+        return False
+    return importlib.util.find_spec(REFERENCE_PACKAGE) is not None
+
+
+# A student's book times the student's own searches, which may be plain Python: one to eleven
+# milliseconds a query on the simulated scan for the other correct submissions of
+# tests/alternatives, a thousand times the reference. Its timing cells run this many queries.
+STUDENT_TIMED_QUERIES = 200
+
+
+def timed_queries(points):
+    """The queries of a cell that times a search, and the words that say which they are.
+
+    In the course's book, every point of ``points``; in a student's book
+    (no reference solutions: the cells run the student's own code) at most
+    :data:`STUDENT_TIMED_QUERIES` of them, evenly spaced, so that a correct
+    plain-Python search builds the book in minutes, not hours.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, D)
+
+    Returns
+    -------
+    queries : ndarray of shape (M, D)
+        C-contiguous.
+    words : str
+        Which they are: ``"all 1,000 points"`` or ``"200 evenly spaced of the 1,000 points"``.
+    """
+    points = np.asarray(points)
+    if _runs_the_reference() or len(points) <= STUDENT_TIMED_QUERIES:
+        return np.ascontiguousarray(points), f"all {len(points):,} points"
+    queries = np.ascontiguousarray(points[:: -(-len(points) // STUDENT_TIMED_QUERIES)])
+    return queries, f"{len(queries):,} evenly spaced of the {len(points):,} points"
 
 
 _STATISTICS = {"min": np.min, "median": np.median}
@@ -54,7 +94,8 @@ def wall_time(function, repeat=5, statistic="median"):
     function : callable
         Called with no argument, ``repeat + 1`` times.
     repeat : int, default 5
-        How many runs to time, at least ``MIN_REPEAT`` (3).
+        How many runs to time, at least ``MIN_REPEAT`` (3). A student's book
+        (no reference solutions) times ``MIN_REPEAT`` runs whatever it says.
     statistic : {"median", "min"}, default "median"
         How the runs' times combine: the median run, or the best one (least
         disturbed by the rest of the machine).
@@ -68,6 +109,8 @@ def wall_time(function, repeat=5, statistic="median"):
     """
     combine = _STATISTICS[check_choice(statistic, "statistic", tuple(_STATISTICS))]
     repeat = check_integer(repeat, "repeat", low=MIN_REPEAT)
+    if not _runs_the_reference():
+        repeat = MIN_REPEAT  # a student's book times the student's code: perhaps plain Python
     result = function()  # the warm-up
     times = []
     for _ in range(repeat):

@@ -540,7 +540,7 @@ def _ticks_at(ax, x, most=10):
 
 
 def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vline=None, floor=None,
-           figsize=(7, 4), styles=None):  # fmt: skip
+           figsize=(7, 4), styles=None, legend_outside=False):  # fmt: skip
     """Several curves over one x axis, with a legend.
 
     Parameters
@@ -556,6 +556,9 @@ def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vli
         Line styles for curves that come in groups (``["-", "--"]``: pairs):
         curve ``j`` is drawn with ``styles[j % len(styles)]`` in the group's
         colour, ``j // len(styles)``. Default: one colour per curve, solid.
+    legend_outside : bool
+        Put the legend to the right of the axes, where no curve runs under it
+        (for many curves that fill the plot).
     """
     import matplotlib.pyplot as plt
 
@@ -573,7 +576,11 @@ def curves(x, values, xlabel, ylabel, xscale="log", yscale="log", ylim=None, vli
         _ticks_at(ax, x)
     if ylim is not None:
         ax.set_ylim(*ylim)
-    ax.legend()
+    if legend_outside:
+        ax.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+        fig.tight_layout()
+    else:
+        ax.legend()
     ax.grid(alpha=0.3, which="both")
     plt.show()
 

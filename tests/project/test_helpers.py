@@ -164,6 +164,22 @@ def test_wall_time_warms_up_then_combines_the_runs_and_returns_the_last_result()
             book.wall_time(lambda: None, **bad)
 
 
+def test_a_students_book_times_fewer_queries_and_runs_than_the_courses(monkeypatch):
+    """Issue 38: a student's book times the student's own searches, perhaps plain Python (a
+    thousand times the reference): every point of the scan as a query took hours."""
+    cloud = np.arange(3000.0).reshape(1000, 3)
+    queries, words = book.timed_queries(cloud)  # the course's book: the reference runs
+    assert np.array_equal(queries, cloud) and words == "all 1,000 points"
+    monkeypatch.setattr(book, "REFERENCE_PACKAGE", None)  # what the release ships
+    queries, words = book.timed_queries(cloud)
+    assert len(queries) == book.STUDENT_TIMED_QUERIES and words == "200 evenly spaced of the 1,000 points"
+    assert np.array_equal(queries, cloud[::5]) and queries.flags.c_contiguous
+    assert book.timed_queries(cloud[:150])[1] == "all 150 points"
+    calls = []
+    book.wall_time(lambda: calls.append(None), repeat=7)
+    assert len(calls) == 1 + book.MIN_REPEAT  # the warm-up and the fewest timed runs
+
+
 def test_the_book_times_code_with_wall_time_only():
     """Issue 38: glued timings from a single cold run (numba compiling) told students the octree's
     radius search was 2.6 times as fast; ``wall_time`` always warms up and repeats."""
