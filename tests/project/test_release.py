@@ -455,6 +455,24 @@ def test_the_student_makefile_shares_the_set_up_rules(release_dir):
         assert completed.returncode == 0, completed.stderr
 
 
+def test_the_students_book_runs_every_page_again_only_after_a_change_to_their_code(release_dir):
+    """Issue 38: a student's make book started from scratch on every run."""
+    stamp = release_dir / "_build" / ".code-stamp"
+    stamp.parent.mkdir(exist_ok=True)
+    stamp.touch()
+    newest = max(path.stat().st_mtime for path in (release_dir / "pcl_course").glob("*.py"))
+    os.utime(stamp, (newest + 10, newest + 10))
+
+    def dry_run():
+        completed = subprocess.run(["make", "-n", "book"], cwd=release_dir, capture_output=True, text=True)
+        assert completed.returncode == 0, completed.stderr
+        return completed.stdout
+
+    assert "jupyter_cache" not in dry_run() and "jupyter-book build" in dry_run()
+    os.utime(release_dir / "pcl_course" / "nn.py", (newest + 20, newest + 20))
+    assert "rm -rf _build/.jupyter_cache" in dry_run()
+
+
 def test_the_workflow_runs_on_changes_to_the_exercises_tags_or_by_hand_and_keeps_its_results(release_dir):
     """Issue 37, item 3: not every push (large classes), any tag, or by hand with a lecture to grade; the
     lecture also from the repository variable PCL_ASSIGNMENT; results.json kept as an artifact."""
