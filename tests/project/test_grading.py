@@ -4,9 +4,11 @@ and lost points for every wrong submission in tests/mutants."""
 import ast
 import importlib
 import json
+import signal
 import subprocess
 import sys
 import time
+import types
 
 import pytest
 from _helpers import load_results
@@ -14,6 +16,7 @@ from _helpers import run_grader as grade
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
 from grading.diagnosis import ONE_LINE_ALREADY
+from grading.errors import TestTimeout
 from grading.instructors import mistakes
 
 
@@ -573,6 +576,97 @@ def test_the_budget_is_a_hard_deadline_for_a_test_under_way(tmp_path):
     texts = [test["text"] for test in summary["tests"]]
     assert any("time budget of 4 s ran out during this test" in text for text in texts), texts
     assert all("ran out" in text for text in texts), texts
+
+
+def test_a_budget_spent_mid_run_skips_the_rest_and_keeps_the_marks_already_given(tmp_path):
+    """A hostile review (h46): a slow, honest submission that spent the budget broke the whole run
+    (an INTERNALERROR, exit status 3, and on Gradescope every mark lost) in 5 of 6 runs: the deadline
+    also went off in pytest's own hooks (a skipped test's report, the results written after it)."""
+    (tmp_path / "slow.py").write_text(
+        "import time\n"
+        "from solutions.normals import *  # noqa: F401,F403\n"
+        "from solutions.normals import fit_plane as _reference\n\n\n"
+        "def fit_plane(*args, **kwargs):\n    time.sleep(0.4)\n    return _reference(*args, **kwargs)\n"
+    )
+    summary, _ = grade(
+        "--reference", "--impl-module", f"normals={tmp_path / 'slow.py'}", "--assignment", "lecture1",
+        "--budget", "3", tmp_path=tmp_path,
+    )  # fmt: skip
+    passed = [t for t in summary["tests"] if t["status"] == "passed"]
+    skipped = [t for t in summary["tests"] if t["text"].startswith("not run: the submission's time budget")]
+    assert passed and len(skipped) >= 20, [(t["name"], t["text"]) for t in summary["tests"]]
+    assert all(t["score"] == 0 for t in skipped)
+    assert summary["score"] == sum(t["score"] for t in passed) > 0
+
+
+def test_a_timeout_caught_by_the_code_under_test_still_ends_the_test_at_the_deadline(tmp_path):
+    """A hostile review (h46): a deadline swallowed by an ``except Exception`` inside the call (the
+    grader's own copy of a large argument, or, here, trusted code) let the call run on untimed and pass."""
+    (tmp_path / "catches.py").write_text(
+        "import time\n"
+        "from solutions.metrics import *  # noqa: F401,F403\n"
+        "from solutions.metrics import chamfer_distance as _reference\n\n\n"
+        "def chamfer_distance(a, b):\n"
+        "    try:\n        time.sleep(10)\n    except Exception:\n        pass  # the deadline, swallowed once\n"
+        "    time.sleep(30)  # untimed, unless the timer goes off again\n"
+        "    return _reference(a, b)\n"
+    )
+    started = time.monotonic()
+    summary, _ = grade(
+        "--reference", "--impl-module", f"metrics={tmp_path / 'catches.py'}", "--function", "chamfer_distance",
+        "--budget", "3", tmp_path=tmp_path,
+    )  # fmt: skip
+    assert time.monotonic() - started < 25  # the second sleep alone is 30 s
+    assert not [t for t in summary["tests"] if t["status"] == "passed"]
+    texts = [t["text"] for t in summary["tests"]]
+    assert any("time budget of 3 s ran out during this test" in text for text in texts), texts
+
+
+class _Item:
+    """What the plugin's timer hooks read of a graded test: its stash, its fixtures, its config."""
+
+    fixturenames = ("impl",)
+
+    def __init__(self, budget, spent):
+        from grading import plugin
+
+        self.stash, self.config = pytest.Stash(), types.SimpleNamespace(stash=pytest.Stash())
+        self.config.getoption = {"--budget": budget}.get
+        self.config.stash[plugin._STARTED_KEY] = time.monotonic() - spent
+
+
+def test_the_deadline_goes_off_only_in_a_tests_call_and_not_at_all_once_the_budget_is_spent():
+    """The race of h46 made certain: a timer armed for a test the budget no longer covers (10 ms,
+    before) went off in pytest's own hooks, a skipped test's report, and broke the run."""
+    from grading import plugin
+
+    settings = types.SimpleNamespace(timeout=240.0)
+    backstop = signal.setitimer(signal.ITIMER_REAL, 0)  # this project test's own timer, set aside
+    try:
+        _check_the_deadline(plugin, settings)
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, *backstop)
+
+
+def _check_the_deadline(plugin, settings):
+    spent = _Item(budget=5.0, spent=6.0)
+    assert plugin.pytest_timeout_set_timer(spent, settings) is True
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)  # no timer at all: setup skips the test
+    assert plugin.pytest_timeout_cancel_timer(spent) is True
+    item = _Item(budget=5.0, spent=1.0)
+    previous = signal.getsignal(signal.SIGALRM)
+    plugin.pytest_timeout_set_timer(item, settings)
+    try:
+        assert 3.5 < signal.getitimer(signal.ITIMER_REAL)[0] <= 4.0  # the budget's rest, not 240 s
+        expire = signal.getsignal(signal.SIGALRM)
+        expire(signal.SIGALRM, None)  # outside the call (a report hook): noted, not raised
+        item.stash[plugin._IN_CALL_KEY] = True
+        with pytest.raises(TestTimeout, match="time budget of 5 s ran out"):
+            expire(signal.SIGALRM, None)
+        assert 0 < signal.getitimer(signal.ITIMER_REAL)[0] <= plugin._REFIRE_SECONDS  # again, if caught
+    finally:
+        plugin.pytest_timeout_cancel_timer(item)
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0) and signal.getsignal(signal.SIGALRM) == previous
 
 
 def test_a_killed_run_leaves_valid_partial_results(tmp_path):
