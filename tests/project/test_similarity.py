@@ -60,7 +60,8 @@ values, vectors = np.linalg.eigh(h)
 if sort:
     order = np.argsort(values)[::-1]
     values, vectors = values[order], vectors[:, order]
-return values, vectors  # <script>alert(1)</script>
+note = "<script>alert(1)</script>"  # students' text, shown escaped
+return values, vectors
 """
 
 DAVE = """
@@ -125,6 +126,27 @@ def test_the_renamed_copy_ranks_first_and_independent_solutions_stay_below(plant
     assert not [p for p in pairs if {p.first, p.second} == {"erin", "frank"}]
     assert skipped[0] == "mallory: not compared: pcl_course/pca.py is a symbolic link: submit regular files only"
     assert [line.split(":")[0] for line in skipped[1:]] == ["pca.py"]  # the code all write alike, left out
+
+
+def test_statements_that_do_nothing_hide_no_copy(tmp_path):
+    """A hostile review (h46): ``pass`` after every statement broke every 25-token run the copy shared
+    (100 % -> 24 %, under the threshold and below two independent students)."""
+    padded = ["if False:", "    raise RuntimeError('never')"]
+    for line in textwrap.dedent(ALICE).strip().splitlines():
+        padded.append(line)
+        if not line.rstrip().endswith(":") and not line.strip().startswith("#"):
+            indent = line[: len(line) - len(line.lstrip())]
+            padded += [f"{indent}pass", f"{indent}...", f"{indent}'nothing'", f"{indent}points"]
+    padded.append("print('unreachable')")
+    padded = "\n".join(padded)
+    compile(pca_source(padded), "pca.py", "exec")  # the padded copy is valid Python
+    for name, body in (("alice", ALICE), ("mallory", padded), ("carol", CAROL), ("dave", DAVE)):
+        student(tmp_path, name, body)
+    pairs, _ = compare_class(tmp_path)
+    first = pairs[0]
+    assert {first.first, first.second} == {"alice", "mallory"} and first.similarity > 0.9, first
+    others = [(p.first, p.second, round(p.similarity, 2)) for p in pairs[1:]]
+    assert all(p.similarity < DISPLAY_THRESHOLD for p in pairs[1:]), others
 
 
 def test_the_report_is_one_self_contained_page_with_the_shared_code_marked(planted_class, tmp_path):
