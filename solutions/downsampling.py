@@ -11,7 +11,10 @@ from solutions._fast.voxel import hash_groups, hash_table_filter, reservoir_choi
 __all__ = ["voxel_grid_downsample", "approximate_voxel_downsample", "farthest_point_sampling", "normal_space_sampling"]
 
 _METHODS = ("centroid", "random")
-_FPS_BUCKET_SIZE = 128  # measured: 64-256 within 10 %, see benchmarks/
+# Buckets of 32 points in groups of 32 buckets: on 1e4-1e6 uniform points, 2-2.5 times as fast
+# as ungrouped buckets of 128, the same samples (make bench times it against its peers).
+_FPS_BUCKET_SIZE = 32
+_FPS_GROUP = 32
 
 
 def _voxel_grid(xyz, voxel_size):
@@ -254,7 +257,7 @@ def farthest_point_sampling(points, n_samples, start_index=0):
     position = np.empty(n, dtype=np.int64)
     position[order] = np.arange(n)
     x, y, z = (np.ascontiguousarray(xyz[order, axis]) for axis in range(3))
-    return bucket_fps(x, y, z, order, n_samples, position[start_index], _FPS_BUCKET_SIZE)
+    return bucket_fps(x, y, z, order, n_samples, position[start_index], _FPS_BUCKET_SIZE, _FPS_GROUP)
 
 
 def _normal_bucket_ids(normals, n_bins):

@@ -8,7 +8,7 @@ import sys
 import pytest
 from _helpers import STEP_BACKSTOP, SUBPROCESS_BACKSTOP
 
-from benchmarks.cases import all_cases
+from benchmarks.cases import FASTEST_PEER, all_cases
 from benchmarks.report import markdown
 from grading import REPO_ROOT
 
@@ -105,6 +105,9 @@ def test_committed_results_cover_every_target():
         assert case.id in measured, f"{case.id} missing from {RESULTS.name}: run make bench"
         entry = measured[case.id]
         peer, limit = case.target
+        if peer == FASTEST_PEER:  # resolved by the report: the peer with the smallest median of the run
+            peers = {name: r["median_s"] for name, r in entry["results"].items() if name != "reference"}
+            peer = min(peers, key=peers.get)
         assert entry["target"] == {
             "peer": peer,
             "limit": limit,

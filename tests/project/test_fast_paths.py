@@ -61,6 +61,15 @@ def test_bucket_fps_ignores_extra_columns_and_uses_small_buckets(rng):
     np.testing.assert_array_equal(downsampling.farthest_point_sampling(points, 300, start_index=5), expected)
 
 
+def test_bucket_fps_skips_whole_groups_of_buckets_exactly(rng):
+    # Several groups of buckets and a partial last one (5,000 points: 157 buckets of 32, 5 groups),
+    # and a lattice whose equal distances everywhere test the tie rule across groups.
+    lattice = np.stack(np.meshgrid(*[np.arange(17.0)] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+    for points, n_samples in ((rng.random((5000, 3)), 1500), (lattice, 900)):
+        expected = plain.farthest_point_sampling(points, n_samples, 7)
+        np.testing.assert_array_equal(downsampling.farthest_point_sampling(points, n_samples, start_index=7), expected)
+
+
 # --- voxel grid: every grouping strategy ------------------------------------------
 
 
