@@ -16,9 +16,10 @@ helper). Functions defined here have one definition each, so a name always
 denotes the same code.
 """
 
+import numpy as np
 from numba import njit
 
-__all__ = ["search_left", "sort_range", "sort_pairs"]
+__all__ = ["search_left", "sort_range", "sort_pairs", "radix_argsort"]
 
 _SMALL = 16  # ranges this short: insertion sort
 
@@ -143,3 +144,38 @@ def search_left(keys, value):
         else:
             hi = middle
     return lo
+
+
+@njit(cache=True, nogil=True)
+def radix_argsort(keys):
+    """Indices that sort the uint64 ``keys`` ascending, equal keys in index order (stable).
+
+    A least-significant-digit radix sort, one byte per pass; a pass whose
+    byte is the same in every key moves nothing and is skipped. O(N) for
+    the Z-order codes of a cloud, where NumPy's stable argsort of 64-bit
+    keys merges in O(N log N).
+    """
+    n = keys.shape[0]
+    counts = np.zeros((8, 256), dtype=np.int64)
+    for i in range(n):
+        value = keys[i]
+        for byte in range(8):
+            counts[byte, (value >> np.uint64(8 * byte)) & np.uint64(255)] += 1
+    index, spare_index = np.arange(n), np.empty(n, dtype=np.int64)
+    current, spare = keys.copy(), np.empty(n, dtype=np.uint64)
+    start = np.empty(256, dtype=np.int64)
+    for byte in range(8):
+        if counts[byte].max() == n:
+            continue
+        total = 0
+        for digit in range(256):
+            start[digit] = total
+            total += counts[byte, digit]
+        for i in range(n):
+            digit = (current[i] >> np.uint64(8 * byte)) & np.uint64(255)
+            position = start[digit]
+            start[digit] = position + 1
+            spare[position], spare_index[position] = current[i], index[i]
+        current, spare = spare, current
+        index, spare_index = spare_index, index
+    return index

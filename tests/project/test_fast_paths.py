@@ -21,6 +21,8 @@ from solutions import downsampling, filters, normals, pca
 from solutions._fast.eig3 import smallest_eigenpair
 from solutions._fast.grid import grid_is_usable, grid_radius_count
 from solutions._fast.knn import leaf_knn
+from solutions._fast.order import morton_order
+from solutions._fast.sorting import radix_argsort
 from solutions._fast.voxel import hash_groups
 
 # Run again with numba's bounds checking: tests/project/test_kernels.py.
@@ -68,6 +70,38 @@ def test_bucket_fps_skips_whole_groups_of_buckets_exactly(rng):
     for points, n_samples in ((rng.random((5000, 3)), 1500), (lattice, 900)):
         expected = plain.farthest_point_sampling(points, n_samples, 7)
         np.testing.assert_array_equal(downsampling.farthest_point_sampling(points, n_samples, start_index=7), expected)
+
+
+# --- Z-order: the radix sort against NumPy's stable argsort ---------------------------
+
+
+def test_radix_argsort_is_numpys_stable_argsort(rng):
+    for keys in (
+        rng.integers(0, 2**63, size=5000, dtype=np.uint64),  # every byte varies
+        rng.integers(0, 4, size=5000).astype(np.uint64) << np.uint64(40),  # ties, one byte varies
+        np.full(100, 2**64 - 1, dtype=np.uint64),  # all equal, the top bit set
+        np.empty(0, dtype=np.uint64),
+    ):
+        np.testing.assert_array_equal(radix_argsort(keys), np.argsort(keys, kind="stable"))
+
+
+def test_morton_order_is_the_stable_order_of_the_codes(rng):
+    """The codes written out with NumPy, as ``order.py`` had them, sorted by NumPy's stable argsort."""
+
+    def spread(v):
+        v = v & np.uint64(0x1FFFFF)
+        for shift, mask in ((32, 0x1F00000000FFFF), (16, 0x1F0000FF0000FF), (8, 0x100F00F00F00F00F)):
+            v = (v | (v << np.uint64(shift))) & np.uint64(mask)
+        v = (v | (v << np.uint64(4))) & np.uint64(0x10C30C30C30C30C3)
+        return (v | (v << np.uint64(2))) & np.uint64(0x1249249249249249)
+
+    extra = [("view", rng.random((2000, 5))[:, 1:4]), ("far", rng.random((900, 3)) + 1e9)]
+    for name, xyz in sorted(CLOUDS.items()) + extra:
+        lower, upper = xyz.min(axis=0), xyz.max(axis=0)
+        span = float((upper - lower).max()) or 1.0
+        cells = np.minimum((xyz - lower) * ((2**21 - 1) / span), 2**21 - 1).astype(np.uint64)
+        codes = spread(cells[:, 0]) | (spread(cells[:, 1]) << np.uint64(1)) | (spread(cells[:, 2]) << np.uint64(2))
+        np.testing.assert_array_equal(morton_order(xyz), np.argsort(codes, kind="stable"), err_msg=name)
 
 
 # --- voxel grid: every grouping strategy ------------------------------------------
