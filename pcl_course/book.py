@@ -15,7 +15,7 @@ import numpy as np
 
 from pcl_course.validation import check_choice, check_integer
 
-__all__ = ["implementation", "timed_queries", "wall_time"]
+__all__ = ["implementation", "timed_code", "timed_queries", "wall_time"]
 
 # Where the reference solutions live in the instructors' repository; the
 # student release sets it to None (it ships no solutions).
@@ -46,6 +46,18 @@ def _runs_the_reference():
 # milliseconds a query on the simulated scan for the other correct submissions of
 # tests/alternatives, a thousand times the reference. Its timing cells run this many queries.
 STUDENT_TIMED_QUERIES = 200
+
+
+def timed_code():
+    """Words for the code a timing cell runs: the course's reference, or the student's own.
+
+    Returns
+    -------
+    words : str
+        ``"the reference, compiled and on every core"`` in the course's book,
+        ``"your own code"`` in a student's.
+    """
+    return "the reference, compiled and on every core" if _runs_the_reference() else "your own code"
 
 
 def timed_queries(points):
