@@ -57,7 +57,10 @@ lint: setup
 # it). The build (then the checks of the built book, marker book) and nbval run one page or
 # one browser at a time on one core, and many project tests wait on a subprocess: all run
 # side by side with the project's tests that do not read the built book, on three workers
-# (README "Tests"). Every limit of the tests is CPU time, or a wall-clock backstop far above it.
+# (README "Tests"). --maxschedchunk=1: xdist hands each worker its next test as it finishes one
+# (by default it deals out a quarter of a worker's share at once, so all the tests marked long,
+# collected first, went to one worker). Every limit of the tests is CPU time, or a wall-clock
+# backstop far above it.
 test: lint $(CODE_STAMP) $(NUMBA_STAMP)
 	@if [ -d _build/.jupyter_cache ]; then $(MAKE) --no-print-directory notebooks || exit 1; \
 	    echo "Building the book and checking it (_build/book.log), nbval (_build/nbval.log), beside the tests"; \
@@ -70,7 +73,7 @@ test: lint $(CODE_STAMP) $(NUMBA_STAMP)
 	      > _build/nbval.log 2>&1; echo $$? > _build/nbval.status; \
 	  else echo "nbval: not run, the book's build executed every page (no execution cache)" > _build/nbval.log; \
 	      echo 0 > _build/nbval.status; fi; } & \
-	$(BIN)/python -m pytest -n 3 --durations=20 -m "not book"; tests=$$?; \
+	$(BIN)/python -m pytest -n 3 --maxschedchunk=1 --durations=20 -m "not book"; tests=$$?; \
 	wait; tail -n 1 _build/nbval.log; tail -n 1 _build/book.log; \
 	if [ "$$(cat _build/book.status)" != 0 ]; then cat _build/book.log; echo "make test: the book's build or its checks failed"; exit 1; fi; \
 	if [ "$$(cat _build/nbval.status)" != 0 ]; then cat _build/nbval.log; echo "make test: nbval failed"; exit 1; fi; \

@@ -25,10 +25,11 @@ def pytest_collection_modifyitems(items):
     """Every project test without its own ``timeout`` marker gets the wall-clock backstop
     (``tests/_helpers.py``); graded tests keep the grader's (grading.config.TEST_TIMEOUT).
 
-    The order (a stable sort, the same in every xdist worker): tests marked ``long`` first, as
-    xdist deals the first tests out in turn, so that they start at once on every worker instead
-    of ending the run on one while the others are idle; the tests that read the reference's
-    grading last, by when :func:`pytest_collection_finish`'s grading is ready."""
+    The order (a stable sort, the same in every xdist worker): tests marked ``long`` first, so
+    that, with xdist handing out one test at a time (``--maxschedchunk=1``, the Makefile), they
+    start at once on every worker instead of ending the run on one while the others are idle;
+    the tests that read the reference's grading last, by when :func:`pytest_collection_finish`'s
+    grading is ready."""
     for item in items:
         if item.path.is_relative_to(PROJECT_TESTS) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(TEST_BACKSTOP))
