@@ -640,7 +640,7 @@ def test_the_deadline_goes_off_only_in_a_tests_call_and_not_at_all_once_the_budg
     before) went off in pytest's own hooks, a skipped test's report, and broke the run."""
     from grading import plugin
 
-    settings = types.SimpleNamespace(timeout=240.0)
+    settings = types.SimpleNamespace(timeout=config.TEST_TIMEOUT)
     backstop = signal.setitimer(signal.ITIMER_REAL, 0)  # this project test's own timer, set aside
     try:
         _check_the_deadline(plugin, settings)
