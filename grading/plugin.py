@@ -48,7 +48,10 @@ _ALARM_KEY = pytest.StashKey[object]()  # a graded test's previous SIGALRM handl
 _IN_CALL_KEY = pytest.StashKey[bool]()  # a graded test's call is under way (the only phase that runs submissions)
 _FIRED_KEY = pytest.StashKey[bool]()  # its timer has gone off
 _TIMEOUT_KEY = pytest.StashKey[tuple]()  # (seconds, budget): the TestTimeout its timer raises
-_REFIRE_SECONDS = 1.0  # a timeout caught inside the call goes off again after this
+# A timeout caught inside the call goes off again after this: longer than the sandbox's own
+# clean-up after a timeout (up to 5 s waiting for a killed worker's processes), which a second
+# timeout must not cut short.
+_REFIRE_SECONDS = 10.0
 
 
 def pytest_addoption(parser):
@@ -328,7 +331,7 @@ def pytest_timeout_set_timer(item, settings):
     # raised in pytest's own hooks (a skip's report, the results written after a test) it
     # would break the whole run (a hostile review: an honest, slow submission lost every
     # mark on Gradescope). Gone off outside the call, it fails the call when that starts;
-    # caught by some code inside the call, it goes off again a second later, and the call's
+    # caught by some code inside the call, it goes off again ten seconds later, and the call's
     # end fails the test all the same.
     remaining = _remaining_budget(item.config)
     if remaining is not None and remaining <= 0:

@@ -608,7 +608,7 @@ def test_a_timeout_caught_by_the_code_under_test_still_ends_the_test_at_the_dead
         "from solutions.metrics import chamfer_distance as _reference\n\n\n"
         "def chamfer_distance(a, b):\n"
         "    try:\n        time.sleep(10)\n    except Exception:\n        pass  # the deadline, swallowed once\n"
-        "    time.sleep(30)  # untimed, unless the timer goes off again\n"
+        "    time.sleep(90)  # untimed, unless the timer goes off again\n"
         "    return _reference(a, b)\n"
     )
     started = time.monotonic()
@@ -616,7 +616,7 @@ def test_a_timeout_caught_by_the_code_under_test_still_ends_the_test_at_the_dead
         "--reference", "--impl-module", f"metrics={tmp_path / 'catches.py'}", "--function", "chamfer_distance",
         "--budget", "3", tmp_path=tmp_path,
     )  # fmt: skip
-    assert time.monotonic() - started < 25  # the second sleep alone is 30 s
+    assert time.monotonic() - started < 60  # the second sleep alone is 90 s
     assert not [t for t in summary["tests"] if t["status"] == "passed"]
     texts = [t["text"] for t in summary["tests"]]
     assert any("time budget of 3 s ran out during this test" in text for text in texts), texts
