@@ -54,10 +54,11 @@ def timed_code():
     Returns
     -------
     words : str
-        ``"the reference, compiled and on every core"`` in the course's book,
+        ``"the reference, compiled"`` in the course's book (on every core only for
+        thousands of queries, so the words do not say),
         ``"your own code"`` in a student's.
     """
-    return "the reference, compiled and on every core" if _runs_the_reference() else "your own code"
+    return "the reference, compiled" if _runs_the_reference() else "your own code"
 
 
 def timed_queries(points):
