@@ -4,6 +4,7 @@
 #   make test-images  build Gradescope's image and the README's set-up on Ubuntu 22.04
 #                 and Debian 12 from their archives (slow; root; not part of make test)
 #   make lint     ruff check and ruff format --check (rules in pyproject.toml)
+#   make numba-cache  compile every numba kernel once, plain and bounds-checked (make test does it first)
 #   make grade SUBMISSION=dir    grade a student's clone
 #   make requirements   re-pin requirements/ (the lock and its two subsets)
 #   make bench    time the references against Open3D, scikit-learn and fpsample
@@ -15,7 +16,7 @@ GRADESCOPE_ZIP ?= _build/gradescope/autograder-$(ASSIGNMENT).zip
 
 include scripts/setup.mk
 
-.PHONY: lint book notebooks test test-images grade gradescope bench requirements clean
+.PHONY: lint book notebooks numba-cache test test-images grade gradescope bench requirements clean
 
 # The execution cache keys on each page's own code only: when the package code
 # the pages run changes, drop the cache (and Sphinx's saved environment, or it
@@ -61,7 +62,23 @@ lint: setup
 # (by default it deals out a quarter of a worker's share at once, so all the tests marked long,
 # collected first, went to one worker). Every limit of the tests is CPU time, or a wall-clock
 # backstop far above it.
-test: lint $(CODE_STAMP) $(NUMBA_STAMP)
+# numba compiles a kernel when a process first calls it, and caches it on disk (solutions/_fast/
+# __pycache__). On a fresh clone every process of make test that calls the reference (the
+# gradings, the kernel tests, the book) would compile them all at once: a minute of CPU each.
+# A grading of the reference compiles them once, before the rest starts; beside it, a second one,
+# bounds-checked, fills the cache of test_kernels' bounds-checked run (it ignores the flag, hence
+# its own folder). About 70 s on a fresh clone, 10 s when the caches are warm.
+NUMBA_CHECKED_CACHE := _build/numba-boundscheck
+numba-cache: setup $(NUMBA_STAMP)
+	{ $(BIN)/python -m grading grade --reference --results _build/numba-cache.json > _build/numba-cache.log 2>&1; \
+	  echo $$? > _build/numba-cache.status; } & \
+	NUMBA_BOUNDSCHECK=1 NUMBA_CACHE_DIR=$(NUMBA_CHECKED_CACHE) $(BIN)/python -m grading grade --reference \
+	    --results _build/numba-cache-checked.json > _build/numba-cache-checked.log 2>&1; checked=$$?; wait; \
+	if [ "$$(cat _build/numba-cache.status)" != 0 ] || [ $$checked != 0 ]; then \
+	    tail -n 20 _build/numba-cache.log _build/numba-cache-checked.log; \
+	    echo "make numba-cache: grading the reference failed"; exit 1; fi
+
+test: lint $(CODE_STAMP) $(NUMBA_STAMP) numba-cache
 	@if [ -d _build/.jupyter_cache ]; then $(MAKE) --no-print-directory notebooks || exit 1; \
 	    echo "Building the book and checking it (_build/book.log), nbval (_build/nbval.log), beside the tests"; \
 	else rm -rf _build/notebooks; \
