@@ -57,6 +57,7 @@ COMMON_SHARE = 0.5
 COMMON_MIN_STUDENTS = 3
 FAMILY_SHARE = 0.8
 DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
+DEAD_CODE_ROUNDS = 5  # passes of comparable(): a dead store feeding a dead store feeding ...
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
 
 
@@ -83,18 +84,60 @@ class Pair:
         return max(self.first_share, self.second_share)
 
 
+def _read_names(tree):
+    """The names ``tree`` reads anywhere (loaded, deleted, or declared ``global``/``nonlocal``)."""
+    read = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and not isinstance(node.ctx, ast.Store):
+            read.add(node.id)
+        elif isinstance(node, ast.Global | ast.Nonlocal):
+            read.update(node.names)
+    return read
+
+
 class _DeadCode(ast.NodeTransformer):
     """Drops the statements that do nothing: ``pass``, a bare constant or name (a docstring too),
-    an ``if`` on a false constant (its ``else`` kept), and what follows a ``return``, ``raise``,
-    ``break`` or ``continue`` in its block. Dead statements sprinkled through a copy break every
-    run of tokens the fingerprints share (a hostile review, h46: ``pass`` after each statement
-    took an exact copy from 100 % to 24 %, under the report's threshold)."""
+    an ``if`` on a false constant (its ``else`` kept), what follows a ``return``, ``raise``,
+    ``break`` or ``continue`` in its block, a name assigned to itself, and a store to names the
+    module never reads (``_ = 0``, ``_ = len(points)``: whatever its value does, it is no part of
+    the code's logic). Dead statements sprinkled through a copy break every run of tokens the
+    fingerprints share (a hostile review, h46: ``pass`` after each statement took an exact copy
+    from 100 % to 24 %, under the report's threshold).
 
-    def _statements(self, statements, required):
+    Parameters
+    ----------
+    read : set of str
+        The names the module reads (:func:`_read_names`).
+    """
+
+    def __init__(self, read):
+        self.read = read
+
+    def _dead_store(self, statement):
+        """None if ``statement`` only stores into names the module never reads, or a name into
+        itself; ``statement`` otherwise."""
+        if isinstance(statement, ast.Assign):
+            targets, value = statement.targets, statement.value
+            if len(targets) == 1 and isinstance(value, ast.Name) and getattr(targets[0], "id", None) == value.id:
+                return None  # x = x
+        elif isinstance(statement, ast.AugAssign | ast.AnnAssign):
+            targets = [statement.target]
+        else:
+            return statement
+        names = [node for target in targets for node in ast.walk(target)]
+        if not all(isinstance(n, ast.Name | ast.Tuple | ast.List | ast.Store) for n in names):
+            return statement  # a store into an attribute or an item has an effect
+        if any(isinstance(n, ast.Name) and n.id in self.read for n in names):
+            return statement
+        return None
+
+    def _statements(self, statements, required, in_class=False):
         kept = []
         for statement in statements:
             statement = self.visit(statement)
-            if isinstance(statement, ast.Pass):
+            if not in_class:  # a class's attributes are read as attributes, never as names
+                statement = self._dead_store(statement)
+            if statement is None or isinstance(statement, ast.Pass):
                 continue
             if isinstance(statement, ast.Expr) and isinstance(statement.value, ast.Constant | ast.Name):
                 continue
@@ -110,7 +153,7 @@ class _DeadCode(ast.NodeTransformer):
         for field, value in ast.iter_fields(node):
             if isinstance(value, list) and value and all(isinstance(v, ast.stmt) for v in value):
                 required = field != "orelse" and not isinstance(node, ast.Module)
-                setattr(node, field, self._statements(value, required))
+                setattr(node, field, self._statements(value, required, isinstance(node, ast.ClassDef)))
             elif isinstance(value, list):
                 for child in value:
                     if isinstance(child, ast.AST):
@@ -122,9 +165,17 @@ class _DeadCode(ast.NodeTransformer):
 
 def comparable(text):
     """``text`` as the report compares it: parsed and written back (comments and layout gone) without
-    the statements that do nothing (:class:`_DeadCode`); ``text`` itself if Python cannot parse it."""
+    the statements that do nothing (:class:`_DeadCode`, again until none is left: a dead store may
+    have been the only reader of another); ``text`` itself if Python cannot parse it."""
     try:
-        return ast.unparse(_DeadCode().visit(ast.parse(text)))
+        tree = ast.parse(text)
+        written = None
+        for _ in range(DEAD_CODE_ROUNDS):
+            tree = _DeadCode(_read_names(tree)).visit(tree)
+            previous, written = written, ast.unparse(tree)
+            if written == previous:
+                break
+        return written
     except (SyntaxError, ValueError, RecursionError):
         return text
 

@@ -60,7 +60,7 @@ values, vectors = np.linalg.eigh(h)
 if sort:
     order = np.argsort(values)[::-1]
     values, vectors = values[order], vectors[:, order]
-note = "<script>alert(1)</script>"  # students' text, shown escaped
+print("<script>alert(1)</script>")  # students' text, shown escaped
 return values, vectors
 """
 
@@ -128,15 +128,23 @@ def test_the_renamed_copy_ranks_first_and_independent_solutions_stay_below(plant
     assert [line.split(":")[0] for line in skipped[1:]] == ["pca.py"]  # the code all write alike, left out
 
 
-def test_statements_that_do_nothing_hide_no_copy(tmp_path):
+# Statements that do nothing, put after every statement of a copy.
+PADDING = {
+    "no-ops": ["pass", "...", "'nothing'", "points"],
+    "dead stores": ["_ = 0", "junk = points", "points = points", "junk += 1", "tally: int = len(points)"],
+}
+
+
+@pytest.mark.parametrize("padding", sorted(PADDING))
+def test_statements_that_do_nothing_hide_no_copy(padding, tmp_path):
     """A hostile review (h46): ``pass`` after every statement broke every 25-token run the copy shared
-    (100 % -> 24 %, under the threshold and below two independent students)."""
-    padded = ["if False:", "    raise RuntimeError('never')"]
+    (100 % -> 24 %, under the threshold and below two independent students); so did ``_ = 0``."""
+    padded = ["if False:", "    raise RuntimeError('never')", "junk = 0"]
     for line in textwrap.dedent(ALICE).strip().splitlines():
         padded.append(line)
         if not line.rstrip().endswith(":") and not line.strip().startswith("#"):
             indent = line[: len(line) - len(line.lstrip())]
-            padded += [f"{indent}pass", f"{indent}...", f"{indent}'nothing'", f"{indent}points"]
+            padded += [f"{indent}{statement}" for statement in PADDING[padding]]
     padded.append("print('unreachable')")
     padded = "\n".join(padded)
     compile(pca_source(padded), "pca.py", "exec")  # the padded copy is valid Python
