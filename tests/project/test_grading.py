@@ -556,20 +556,29 @@ def test_tests_past_the_time_budget_score_zero_and_say_so(tmp_path):
         assert test["text"] == "not run: the submission's time budget of 0 s ran out", test
 
 
+def wrapped_reference(folder, module, function, arguments, body):
+    """Write ``folder/<function>.py``: the reference's ``module`` with ``function(arguments)``
+    running ``body`` (lines of Python, ``time`` imported) before it calls the reference; its path."""
+    path = folder / f"{function}.py"
+    lines = "".join(f"    {line}\n" for line in body)
+    path.write_text(
+        "import time\n"
+        f"from solutions.{module} import *  # noqa: F401,F403\n"
+        f"from solutions.{module} import {function} as _reference\n\n\n"
+        f"def {function}({arguments}):\n{lines}    return _reference({arguments})\n"
+    )
+    return path
+
+
 def test_the_budget_is_a_hard_deadline_for_a_test_under_way(tmp_path):
     """Issue 35's hostile review: a test started just before the budget ran out could run on for its
     whole limit (240 s, calls of up to 120 s each), so a submission that slept after seeing a hidden
     input chose whether the grading ended inside Gradescope's ten minutes. A test under way stops at
     the budget, and says why."""
-    (tmp_path / "sleepy.py").write_text(
-        "import time\n"
-        "from solutions.metrics import *  # noqa: F401,F403\n"
-        "from solutions.metrics import chamfer_distance as _reference\n\n\n"
-        "def chamfer_distance(a, b):\n    time.sleep(25)\n    return _reference(a, b)\n"
-    )
+    sleepy = wrapped_reference(tmp_path, "metrics", "chamfer_distance", "a, b", ["time.sleep(25)"])
     started = time.monotonic()
     summary, _ = grade(
-        "--reference", "--impl-module", f"metrics={tmp_path / 'sleepy.py'}", "--function", "chamfer_distance",
+        "--reference", "--impl-module", f"metrics={sleepy}", "--function", "chamfer_distance",
         "--budget", "4", tmp_path=tmp_path,
     )  # fmt: skip
     assert time.monotonic() - started < 20  # one sleep would be 25 s
@@ -582,14 +591,9 @@ def test_a_budget_spent_mid_run_skips_the_rest_and_keeps_the_marks_already_given
     """A hostile review (h46): a slow, honest submission that spent the budget broke the whole run
     (an INTERNALERROR, exit status 3, and on Gradescope every mark lost) in 5 of 6 runs: the deadline
     also went off in pytest's own hooks (a skipped test's report, the results written after it)."""
-    (tmp_path / "slow.py").write_text(
-        "import time\n"
-        "from solutions.normals import *  # noqa: F401,F403\n"
-        "from solutions.normals import fit_plane as _reference\n\n\n"
-        "def fit_plane(*args, **kwargs):\n    time.sleep(0.4)\n    return _reference(*args, **kwargs)\n"
-    )
+    slow = wrapped_reference(tmp_path, "normals", "fit_plane", "*args, **kwargs", ["time.sleep(0.4)"])
     summary, _ = grade(
-        "--reference", "--impl-module", f"normals={tmp_path / 'slow.py'}", "--assignment", "lecture1",
+        "--reference", "--impl-module", f"normals={slow}", "--assignment", "lecture1",
         "--budget", "3", tmp_path=tmp_path,
     )  # fmt: skip
     passed = [t for t in summary["tests"] if t["status"] == "passed"]
@@ -602,18 +606,17 @@ def test_a_budget_spent_mid_run_skips_the_rest_and_keeps_the_marks_already_given
 def test_a_timeout_caught_by_the_code_under_test_still_ends_the_test_at_the_deadline(tmp_path):
     """A hostile review (h46): a deadline swallowed by an ``except Exception`` inside the call (the
     grader's own copy of a large argument, or, here, trusted code) let the call run on untimed and pass."""
-    (tmp_path / "catches.py").write_text(
-        "import time\n"
-        "from solutions.metrics import *  # noqa: F401,F403\n"
-        "from solutions.metrics import chamfer_distance as _reference\n\n\n"
-        "def chamfer_distance(a, b):\n"
-        "    try:\n        time.sleep(10)\n    except Exception:\n        pass  # the deadline, swallowed once\n"
-        "    time.sleep(90)  # untimed, unless the timer goes off again\n"
-        "    return _reference(a, b)\n"
-    )
+    body = [
+        "try:",
+        "    time.sleep(10)",
+        "except Exception:",
+        "    pass  # the deadline, swallowed once",
+        "time.sleep(90)  # untimed, unless the timer goes off again",
+    ]
+    catches = wrapped_reference(tmp_path, "metrics", "chamfer_distance", "a, b", body)
     started = time.monotonic()
     summary, _ = grade(
-        "--reference", "--impl-module", f"metrics={tmp_path / 'catches.py'}", "--function", "chamfer_distance",
+        "--reference", "--impl-module", f"metrics={catches}", "--function", "chamfer_distance",
         "--budget", "3", tmp_path=tmp_path,
     )  # fmt: skip
     assert time.monotonic() - started < 60  # the second sleep alone is 90 s
