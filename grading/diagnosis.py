@@ -439,69 +439,100 @@ def _wrong(call, truth, model, arguments):
     return call.raised or not model.same(call.result, truth, arguments)
 
 
+# What one call says of one mistake (:func:`_verdict`), in the order of the checks.
+NO_EVIDENCE, REJECTS, WRONG_WHERE_RIGHT, MATCHED, ABSENT, OWN_CHECK, CONTRADICTED = range(7)
+
+
+def _verdict(model, mistake, call, arguments, truth):
+    """What ``call`` says of ``mistake``: ``(kind, detail)``, ``kind`` one of the constants above;
+    ``detail`` is ``(fingerprint of the arguments, chance)`` for MATCHED, None otherwise."""
+    compare = mistake.same or model.same
+    try:
+        predicted = mistake.predict(**copy.deepcopy(arguments))
+    except Exception:
+        predicted = None
+    applies = predicted is not None  # None: the mistake does not apply to this input
+    if isinstance(predicted, Variants) and truth is not RANDOM:
+        # Only the ways of making the mistake that change the answer are evidence.
+        predicted = Variants(v for v in predicted if not _matches(compare, truth, v, arguments)) or None
+    if predicted is None or (truth is not RANDOM and _matches(compare, truth, predicted, arguments)):
+        # The mistake gives the right answer here, or does not apply: no evidence, unless
+        # the mistake is exclusive (then the answer must be right here).
+        if truth is not RANDOM and _wrong(call, truth, model, arguments):
+            if getattr(mistake, "exclusive", False):
+                return REJECTS, None
+            if applies:
+                return WRONG_WHERE_RIGHT, None
+        return NO_EVIDENCE, None
+    answer = Raised(call.error_type) if call.raised else call.result
+    if _matches(compare, answer, predicted, arguments):
+        return MATCHED, (_fingerprint(arguments), _chance(predicted))
+    if (
+        truth is not RANDOM
+        and not call.raised
+        and _chance(predicted) == 0.0  # a random method's mismatch is evidence against
+        and model.same(call.result, truth, arguments)
+    ):
+        return ABSENT, None  # the answer is right here: the mistake is not on this code path
+    if call.raised and call.error_type == "ValueError":
+        return OWN_CHECK, None  # a check of the student's own that the model lacks: no evidence either way
+    return CONTRADICTED, None
+
+
+def _verdicts(model, kept, memo):
+    """``{(id(mistake), id(call)): verdict}`` for every mistake of ``model`` and every kept call
+    (``(call, arguments)``), computed once per pair: ``memo`` keeps them for another diagnosis of
+    the same calls (a grading diagnoses the public tests' calls, then all of them). The truth of a
+    call is computed only for a call whose verdicts are not there yet."""
+    for call, arguments in kept:
+        if all((id(mistake), id(call)) in memo for mistake in model.mistakes):
+            continue
+        try:
+            truth = model.truth(**copy.deepcopy(arguments))
+        except Exception:  # an input the contract rejects: nothing to compare
+            truth = None
+        for mistake in model.mistakes:
+            if truth is None:
+                memo[id(mistake), id(call)] = (NO_EVIDENCE, None)
+            else:
+                memo.setdefault((id(mistake), id(call)), _verdict(model, mistake, call, arguments, truth))
+    return memo
+
+
 def _known_mistake(function, calls, outcomes, failed, context):
     model = context.get("model")
     if model is None:
         return None
     kept = [(c, bind(function, c)) for c in calls if c.kept]
     kept = [(c, arguments) for c, arguments in kept if arguments is not None]
-    truths = {}
-    for call, arguments in kept:
-        try:
-            truths[id(call)] = model.truth(**copy.deepcopy(arguments))
-        except Exception:  # an input the contract rejects: nothing to compare
-            truths[id(call)] = None
+    verdicts = _verdicts(model, kept, context.get("memo", {}))
     best, best_key = None, None
     for mistake in model.mistakes:
         matched, contradicted, luck, seen = set(), set(), {}, {}
         wrong_where_right = set()  # tests with a wrong answer where the mistake gives the right one
         evidence, absent = 0, 0  # calls the mistake predicts; calls where it differs and the answer is right
-        compare = mistake.same or model.same
         rejected = False
-        for call, arguments in kept:
-            truth = truths[id(call)]
-            if truth is None:
-                continue
-            try:
-                predicted = mistake.predict(**copy.deepcopy(arguments))
-            except Exception:
-                predicted = None
-            applies = predicted is not None  # None: the mistake does not apply to this input
-            if isinstance(predicted, Variants) and truth is not RANDOM:
-                # Only the ways of making the mistake that change the answer are evidence.
-                predicted = Variants(v for v in predicted if not _matches(compare, truth, v, arguments)) or None
-            if predicted is None or (truth is not RANDOM and _matches(compare, truth, predicted, arguments)):
-                # The mistake gives the right answer here, or does not apply: no evidence, unless
-                # the mistake is exclusive (then the answer must be right here).
-                if truth is not RANDOM and _wrong(call, truth, model, arguments):
-                    if getattr(mistake, "exclusive", False):
-                        _debug(function, mistake.id, "wrong where the mistake is right", call.test)
-                        rejected = True
-                        break
-                    if applies:
-                        wrong_where_right.add(call.test)
-                continue
-            answer = Raised(call.error_type) if call.raised else call.result
-            if _matches(compare, answer, predicted, arguments):
+        for call, _ in kept:
+            kind, detail = verdicts[id(mistake), id(call)]
+            if kind == REJECTS:
+                _debug(function, mistake.id, "wrong where the mistake is right", call.test)
+                rejected = True
+                break
+            if kind == WRONG_WHERE_RIGHT:
+                wrong_where_right.add(call.test)
+            elif kind == MATCHED:
                 matched.add(call.test)
                 evidence += 1
                 # A random method's right answer may equal the mistake's by chance: a test is
                 # evidence only when that chance, over all of its calls, is small.
                 # Calls with the same arguments (the same seed) are one draw, not several.
-                key = _fingerprint(arguments)
+                key, chance = detail
                 if key not in seen.setdefault(call.test, set()):
                     seen[call.test].add(key)
-                    luck[call.test] = luck.get(call.test, 1.0) * _chance(predicted)
-            elif (
-                truth is not RANDOM
-                and not call.raised
-                and _chance(predicted) == 0.0  # a random method's mismatch is evidence against
-                and model.same(call.result, truth, arguments)
-            ):
-                absent += 1  # the answer is right here: the mistake is not on this code path
-            elif call.raised and call.error_type == "ValueError":
-                pass  # a check of the student's own that the model lacks: no evidence either way
-            else:
+                    luck[call.test] = luck.get(call.test, 1.0) * chance
+            elif kind == ABSENT:
+                absent += 1
+            elif kind == CONTRADICTED:
                 _debug(function, mistake.id, "does not match its prediction", call.test)
                 contradicted.add(call.test)
         if rejected:
@@ -541,7 +572,7 @@ FINDINGS = (
 )
 
 
-def diagnose(function, calls, outcomes, model=None, sources=None):
+def diagnose(function, calls, outcomes, model=None, sources=None, memo=None):
     """The diagnosis of one graded function's lost points, or None.
 
     Parameters
@@ -558,11 +589,15 @@ def diagnose(function, calls, outcomes, model=None, sources=None):
     sources : dict, optional
         Exercise module name -> the submission's source text (for the
         signature check; read, never run).
+    memo : dict, optional
+        What the catalogue's mistakes predicted of these calls, kept for
+        another diagnosis of the same calls (one dict per function; its
+        entries are small: a verdict per mistake and call).
     """
     failed = tuple(t for t, o in outcomes.items() if not o.passed)
     if not failed:
         return None
-    context = {"model": model, "sources": sources or {}}
+    context = {"model": model, "sources": sources or {}, "memo": {} if memo is None else memo}
     for finding in FINDINGS:
         found = finding(function, calls, outcomes, failed, context)
         if found is not None:

@@ -162,8 +162,9 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.timeout(grading_config.TEST_TIMEOUT))
 
 
-def _run_diagnosis(config, function, tests, always):
-    """The diagnosis of ``function`` over ``tests`` (test id -> Outcome), or None."""
+def _run_diagnosis(config, function, tests, always, memo):
+    """The diagnosis of ``function`` over ``tests`` (test id -> Outcome), or None; ``memo``, one dict
+    per function, keeps the catalogue's verdicts on its calls between its diagnoses."""
     impl = config.stash.get(_IMPL_KEY, None)
     model = mistakes.model(function) if mistakes is not None else None
     sources = {GRADED_FUNCTIONS[function]: impl.source(GRADED_FUNCTIONS[function])}
@@ -173,7 +174,7 @@ def _run_diagnosis(config, function, tests, always):
         tests = {nodeid: diagnosis.Outcome(False, diagnosis.CHECK) for nodeid in tests}
     calls = [c for c in impl.calls.get(function, []) if c.test in tests]
     try:
-        found = diagnosis.diagnose(function, calls, tests, model, sources)
+        found = diagnosis.diagnose(function, calls, tests, model, sources, memo)
     except Exception as exc:  # the diagnosis is help, never a reason to lose a grade
         print(f"note: the diagnosis of {function} failed: {type(exc).__name__}: {exc}")
         return None
@@ -208,7 +209,8 @@ def _diagnose(config):
         if not tests or (not always and all(o.passed for o in tests.values())):
             continue
         visible = {nodeid: o for nodeid, o in tests.items() if not results[nodeid].hidden}
-        found = _run_diagnosis(config, function, visible, always) if visible else None
+        memo = {}
+        found = _run_diagnosis(config, function, visible, always, memo) if visible else None
         if found is not None:
             public[function] = found[1]
             for nodeid in found[0].explains:
@@ -220,7 +222,7 @@ def _diagnose(config):
                     result.feedback = ""  # the same cause everywhere: said once, not repeated
         hidden_failed = any(results[n].hidden and not o.passed for n, o in tests.items())
         if hidden_failed or always:
-            found_all = _run_diagnosis(config, function, tests, always)
+            found_all = _run_diagnosis(config, function, tests, always, memo)
             if found_all is not None:
                 everything[function] = found_all[1]
                 # A hidden test it explains says it too when it is a known mistake's fixed line (the other
