@@ -22,5 +22,7 @@ def test_benchmark(benchmark, bench_item, calibrate):
         peak_bytes=calibration.peak_bytes,
         memory_method=calibration.memory_method,
         target=list(case.target) if case.target else None,
+        references=list(case.references),
+        lighter=list(case.lighter),
     )
     benchmark.pedantic(function, rounds=calibration.rounds, iterations=1, warmup_rounds=0)
