@@ -22,7 +22,7 @@ import numpy as np
 
 from benchmarks.cases import FASTEST_PEER
 
-PACKAGES = ("numpy", "scipy", "numba", "open3d", "scikit-learn", "fpsample", "pytest-benchmark")
+PACKAGES = ("numpy", "scipy", "numba", "open3d", "scikit-learn", "fpsample", "pykdtree", "pytest-benchmark")
 
 
 def _memory_gib():
