@@ -22,20 +22,16 @@ from grading.config import EXERCISE_MODULES, FORBIDDEN_IN_MODULE
 from grading.diagnosis import (
     _IMPORT_FIXES,
     ASSERTION,
-    CHANCE_LIMIT,
     CHECK,
     DID_NOT_RAISE,
     ERROR,
     FORBIDDEN,
     NOT_IMPLEMENTED,
-    RANDOM,
     REFUSED,
     SANDBOX,
     Call,
     Diagnosis,
     Outcome,
-    Raised,
-    Variants,
     _did_not_raise,
     _explicit,
     _extra_columns,
@@ -47,10 +43,10 @@ from grading.diagnosis import (
     _signature,
     diagnose,
     explained_line,
-    same,
 )
 from grading.forbidden import scan_source
 from grading.instructors.mistakes import Mistake, Model
+from grading.matching import CHANCE_LIMIT, RANDOM, Raised, Variants, same
 
 FUNCTION = "pca"
 

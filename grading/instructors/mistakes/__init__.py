@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grading.config import GRADED_FUNCTIONS
-from grading.diagnosis import RANDOM, Raised, Variants, same  # noqa: F401  (re-exported for the catalogue modules)
+from grading.matching import RANDOM, Raised, Variants, same  # noqa: F401  (re-exported for the catalogue modules)
 
 
 @dataclass(frozen=True)
