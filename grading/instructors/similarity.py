@@ -25,7 +25,6 @@ by similarity, each with both files side by side and the shared code
 highlighted. A high score is a reason to read the two files, not a verdict.
 """
 
-import ast
 import html
 import io
 import itertools
@@ -43,6 +42,7 @@ from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
 from grading.forbidden import read_source
 from grading.instructors.batch import class_folders, read_gradescope_metadata
+from grading.instructors.dead_code import comparable
 from grading.instructors.gradescope import lay_over_stubs
 from grading.results import clean
 
@@ -57,7 +57,6 @@ COMMON_SHARE = 0.5
 COMMON_MIN_STUDENTS = 3
 FAMILY_SHARE = 0.8
 DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
-DEAD_CODE_ROUNDS = 5  # passes of comparable(): a dead store feeding a dead store feeding ...
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
 
 
@@ -82,102 +81,6 @@ class Pair:
     @property
     def similarity(self):
         return max(self.first_share, self.second_share)
-
-
-def _read_names(tree):
-    """The names ``tree`` reads anywhere (loaded, deleted, or declared ``global``/``nonlocal``)."""
-    read = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Name) and not isinstance(node.ctx, ast.Store):
-            read.add(node.id)
-        elif isinstance(node, ast.Global | ast.Nonlocal):
-            read.update(node.names)
-    return read
-
-
-class _DeadCode(ast.NodeTransformer):
-    """Drops the statements that do nothing: ``pass``, a bare constant or name (a docstring too),
-    an ``if`` on a false constant (its ``else`` kept), what follows a ``return``, ``raise``,
-    ``break`` or ``continue`` in its block, a name assigned to itself, and a store to names the
-    module never reads (``_ = 0``, ``_ = len(points)``: whatever its value does, it is no part of
-    the code's logic). Dead statements sprinkled through a copy break every run of tokens the
-    fingerprints share (a hostile review, h46: ``pass`` after each statement took an exact copy
-    from 100 % to 24 %, under the report's threshold).
-
-    Parameters
-    ----------
-    read : set of str
-        The names the module reads (:func:`_read_names`).
-    """
-
-    def __init__(self, read):
-        self.read = read
-
-    def _dead_store(self, statement):
-        """None if ``statement`` only stores into names the module never reads, or a name into
-        itself; ``statement`` otherwise."""
-        if isinstance(statement, ast.Assign):
-            targets, value = statement.targets, statement.value
-            if len(targets) == 1 and isinstance(value, ast.Name) and getattr(targets[0], "id", None) == value.id:
-                return None  # x = x
-        elif isinstance(statement, ast.AugAssign | ast.AnnAssign):
-            targets = [statement.target]
-        else:
-            return statement
-        names = [node for target in targets for node in ast.walk(target)]
-        if not all(isinstance(n, ast.Name | ast.Tuple | ast.List | ast.Store) for n in names):
-            return statement  # a store into an attribute or an item has an effect
-        if any(isinstance(n, ast.Name) and n.id in self.read for n in names):
-            return statement
-        return None
-
-    def _statements(self, statements, required, in_class=False):
-        kept = []
-        for statement in statements:
-            statement = self.visit(statement)
-            if not in_class:  # a class's attributes are read as attributes, never as names
-                statement = self._dead_store(statement)
-            if statement is None or isinstance(statement, ast.Pass):
-                continue
-            if isinstance(statement, ast.Expr) and isinstance(statement.value, ast.Constant | ast.Name):
-                continue
-            if isinstance(statement, ast.If) and isinstance(statement.test, ast.Constant) and not statement.test.value:
-                kept += self._statements(statement.orelse, required=False)
-                continue
-            kept.append(statement)
-            if isinstance(statement, ast.Return | ast.Raise | ast.Break | ast.Continue):
-                break
-        return kept or ([ast.Pass()] if required else [])
-
-    def generic_visit(self, node):
-        for field, value in ast.iter_fields(node):
-            if isinstance(value, list) and value and all(isinstance(v, ast.stmt) for v in value):
-                required = field != "orelse" and not isinstance(node, ast.Module)
-                setattr(node, field, self._statements(value, required, isinstance(node, ast.ClassDef)))
-            elif isinstance(value, list):
-                for child in value:
-                    if isinstance(child, ast.AST):
-                        self.visit(child)
-            elif isinstance(value, ast.AST):
-                self.visit(value)
-        return node
-
-
-def comparable(text):
-    """``text`` as the report compares it: parsed and written back (comments and layout gone) without
-    the statements that do nothing (:class:`_DeadCode`, again until none is left: a dead store may
-    have been the only reader of another); ``text`` itself if Python cannot parse it."""
-    try:
-        tree = ast.parse(text)
-        written = None
-        for _ in range(DEAD_CODE_ROUNDS):
-            tree = _DeadCode(_read_names(tree)).visit(tree)
-            previous, written = written, ast.unparse(tree)
-            if written == previous:
-                break
-        return written
-    except (SyntaxError, ValueError, RecursionError):
-        return text
 
 
 def _boilerplate_hashes(stubs):
@@ -404,7 +307,8 @@ def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
 reach{"es" if len(shown) == 1 else ""} {threshold:.0%} of a file and {"is" if len(shown) == 1 else "are"} shown.
 The share is the part of a student's file (stub text removed, names folded) that the other file holds too.
 Each file is compared, and shown, as Python reads it: comments and layout gone, and the statements that do
-nothing removed (<code>pass</code>, a bare constant or name, a docstring, unreachable code).
+nothing removed (<code>pass</code>, an expression without a call, a docstring, unreachable code, a store into a
+name nothing reads: <code>grading/instructors/dead_code.py</code>): read the submitted files themselves too.
 A high share is a reason to read both files, not a verdict.</p>
 {f"<ul>{notes}</ul>" if notes else ""}
 <table><thead><tr><th>#</th><th>module</th><th>student</th><th>student</th>

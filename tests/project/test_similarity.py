@@ -131,7 +131,14 @@ def test_the_renamed_copy_ranks_first_and_independent_solutions_stay_below(plant
 # Statements that do nothing, put after every statement of a copy.
 PADDING = {
     "no-ops": ["pass", "...", "'nothing'", "points"],
-    "dead stores": ["_ = 0", "junk = points", "points = points", "junk += 1", "tally: int = len(points)"],
+    # (A store of a call keeps the call: _ = heappush(...) has an effect, and no reading of the
+    # code tells a pure call from another.)
+    "dead stores": ["_ = 0", "junk = points", "points = points", "junk += 1", "tally: int = points.size"],
+    # A hostile review (h47): one of these after every statement, and between two functions, took
+    # the copy to 15 %; a name read only by its own stores or deleted, to 29 %.
+    "pure expressions": ["-1", "()", "points.shape", "assert 1", "global _g"],
+    "blocks that run never or always": ["if 1:\n    pass", "while 0:\n    _ = 1", "for _ in ():\n    pass"],
+    "self-reads and deletions": ["_k = _k + 1", "_ = 0", "del _", "import os", "def _():\n    return 0"],
 }
 
 
@@ -139,12 +146,15 @@ PADDING = {
 def test_statements_that_do_nothing_hide_no_copy(padding, tmp_path):
     """A hostile review (h46): ``pass`` after every statement broke every 25-token run the copy shared
     (100 % -> 24 %, under the threshold and below two independent students); so did ``_ = 0``."""
-    padded = ["if False:", "    raise RuntimeError('never')", "junk = 0"]
+    padded = ["if False:", "    raise RuntimeError('never')", "junk = 0", "_k = 0"]
     for line in textwrap.dedent(ALICE).strip().splitlines():
+        indent = line[: len(line) - len(line.lstrip())]
+        pad = [textwrap.indent(statement, indent) for statement in PADDING[padding]]
+        if line.lstrip().startswith("return"):
+            padded += pad  # before the return too: the run into the next function is broken as well
         padded.append(line)
         if not line.rstrip().endswith(":") and not line.strip().startswith("#"):
-            indent = line[: len(line) - len(line.lstrip())]
-            padded += [f"{indent}{statement}" for statement in PADDING[padding]]
+            padded += pad
     padded.append("print('unreachable')")
     padded = "\n".join(padded)
     compile(pca_source(padded), "pca.py", "exec")  # the padded copy is valid Python
@@ -155,6 +165,16 @@ def test_statements_that_do_nothing_hide_no_copy(padding, tmp_path):
     assert {first.first, first.second} == {"alice", "mallory"} and first.similarity > 0.9, first
     others = [(p.first, p.second, round(p.similarity, 2)) for p in pairs[1:]]
     assert all(p.similarity < DISPLAY_THRESHOLD for p in pairs[1:]), others
+
+
+def test_a_module_the_parser_cannot_take_is_compared_as_it_is():
+    """A hostile review (h47): 6,000 unary minus signs made ast.parse raise MemoryError (Python
+    3.11), which stopped the whole report."""
+    from grading.instructors.dead_code import comparable
+
+    deep = "x = " + "-" * 6000 + "1\n"
+    assert comparable(deep) == deep
+    assert comparable("def f(:\n") == "def f(:\n"
 
 
 def test_the_report_is_one_self_contained_page_with_the_shared_code_marked(planted_class, tmp_path):

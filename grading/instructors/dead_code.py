@@ -1,0 +1,215 @@
+"""Python source as the similarity report compares it: without the statements that do nothing.
+
+Statements that do nothing, sprinkled through a copy, break every run of
+tokens the fingerprints share: ``pass`` after each statement took an exact
+copy from 100 % to 24 % (a hostile review, h46), and ``-1``, ``assert 1`` or
+``global _g`` after each, with one between two functions, to 15 % (h47),
+under the report's threshold. :func:`comparable` parses a module, drops them
+(:class:`_DeadCode`), again until none is left (a dead store may have been
+the only reader of another), and writes the module back, comments and layout
+gone. What it drops:
+
+- ``pass``; an expression statement whose evaluation has no effect
+  (:func:`_pure`: constants, names, operators, attributes, subscripts,
+  displays of them; a docstring too); ``assert`` on a true constant;
+  ``global`` and ``nonlocal``;
+- a block under a constant test: ``if 0:`` (its ``else`` kept), ``if 1:``
+  (its body kept), ``while 0:``, ``for _ in ():`` (their ``else`` kept);
+- what follows a ``return``, ``raise``, ``break`` or ``continue`` in its block;
+- a store into names the module never reads, or reads only to store into
+  themselves (``_ = 0``, ``x = x``, ``k = k + 1`` and nowhere else); a store
+  of a value with an effect keeps the value, as a statement
+  (``heappush(heap, item)`` of ``_ = heappush(heap, item)``);
+- ``del`` of such names; an import, or a function or class defined inside
+  another, whose names are never read (the module's own functions are its
+  interface: kept).
+
+A class's attributes are read as attributes, never as names: stores in a
+class body are kept. Names read only through ``eval``, ``globals()`` or
+``locals()`` are taken as unread: the report compares, it does not run.
+"""
+
+import ast
+
+__all__ = ["comparable"]
+
+DEAD_CODE_ROUNDS = 5  # passes of comparable(): a dead store feeding a dead store feeding ...
+
+_STORES = (ast.Assign, ast.AugAssign, ast.AnnAssign)
+_SCOPES = (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)
+
+
+def _pure(node):
+    """Whether evaluating the expression ``node`` has no effect to speak of (no call, no walrus,
+    no yield): a constant, a name, an operator, an attribute or subscript, a display of them."""
+    if node is None or isinstance(node, ast.Constant | ast.Name | ast.Lambda):
+        return True
+    if isinstance(node, ast.UnaryOp):
+        return _pure(node.operand)
+    if isinstance(node, ast.BinOp):
+        return _pure(node.left) and _pure(node.right)
+    if isinstance(node, ast.BoolOp):
+        return all(_pure(value) for value in node.values)
+    if isinstance(node, ast.Compare):
+        return _pure(node.left) and all(_pure(c) for c in node.comparators)
+    if isinstance(node, ast.Tuple | ast.List | ast.Set):
+        return all(_pure(element) for element in node.elts)
+    if isinstance(node, ast.Attribute):
+        return _pure(node.value)
+    if isinstance(node, ast.Subscript):
+        return _pure(node.value) and _pure(node.slice)
+    if isinstance(node, ast.Slice):
+        return _pure(node.lower) and _pure(node.upper) and _pure(node.step)
+    return False
+
+
+def _stored_names(targets):
+    """The names ``targets`` store into, or None if one of them stores into anything else
+    (an attribute, an item, a starred name: that store has an effect, or is not simple)."""
+    names = set()
+    for node in (n for target in targets for n in ast.walk(target)):
+        if isinstance(node, ast.Name):
+            names.add(node.id)
+        elif not isinstance(node, ast.Tuple | ast.List | ast.Store | ast.Del):
+            return None
+    return names
+
+
+def _read_names(tree):
+    """The names ``tree`` loads anywhere, but in a store's own value into that same name."""
+    own = set()  # the Name nodes a store reads of its own targets: k = k + 1
+    for node in ast.walk(tree):
+        if isinstance(node, _STORES) and node.value is not None:
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            stored = _stored_names(targets) or set()
+            own |= {id(n) for n in ast.walk(node.value) if isinstance(n, ast.Name) and n.id in stored}
+    return {
+        node.id
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load) and id(node) not in own
+    }
+
+
+def _constant_truth(test):
+    """The truth of a constant test, or None if ``test`` is not a constant."""
+    return bool(test.value) if isinstance(test, ast.Constant) else None
+
+
+def _empty_display(node):
+    return (isinstance(node, ast.Tuple | ast.List | ast.Set) and not node.elts) or (
+        isinstance(node, ast.Constant) and node.value in ("", b"")
+    )
+
+
+class _DeadCode(ast.NodeTransformer):
+    """One pass of :func:`comparable`: every block without its dead statements (the module's docstring).
+
+    Parameters
+    ----------
+    read : set of str
+        The names the module reads (:func:`_read_names`).
+    """
+
+    def __init__(self, read):
+        self.read = read
+        self.in_class = [False]  # whether the innermost scope is a class body
+        self.depth = 0  # 0: the module's own statements
+
+    def _unread(self, names):
+        return names is not None and not (names & self.read)
+
+    def _dead_store(self, statement):
+        """``statement`` if it is no dead store; else None, or its value as a statement when that
+        value has an effect."""
+        if isinstance(statement, ast.Assign):
+            targets, value = statement.targets, statement.value
+            if len(targets) == 1 and isinstance(value, ast.Name) and getattr(targets[0], "id", None) == value.id:
+                return None  # x = x
+        elif isinstance(statement, ast.AugAssign | ast.AnnAssign):
+            targets, value = [statement.target], statement.value
+        elif isinstance(statement, ast.Delete):
+            return None if self._unread(_stored_names(statement.targets)) else statement
+        else:
+            return statement
+        if not self._unread(_stored_names(targets)):
+            return statement
+        return None if _pure(value) else ast.Expr(value)
+
+    def _unused_definition(self, statement):
+        """Whether ``statement`` defines only names nobody reads: an import anywhere, a function or
+        class inside another (the module's own are its interface)."""
+        if isinstance(statement, ast.Import | ast.ImportFrom):
+            if any(alias.name == "*" for alias in statement.names):
+                return False
+            names = {(alias.asname or alias.name).split(".")[0] for alias in statement.names}
+            return not (names & self.read)
+        if isinstance(statement, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            return self.depth > 0 and not self.in_class[-1] and statement.name not in self.read
+        return False
+
+    def _statements(self, statements, required):
+        kept = []
+        for statement in statements:
+            if not self.in_class[-1]:
+                statement = self._dead_store(statement)
+            if statement is None or self._unused_definition(statement):
+                continue
+            if isinstance(statement, ast.Pass | ast.Global | ast.Nonlocal):
+                continue
+            if isinstance(statement, ast.Expr) and _pure(statement.value):
+                continue
+            if isinstance(statement, ast.Assert) and _constant_truth(statement.test) is True:
+                continue
+            if isinstance(statement, ast.If) and _constant_truth(statement.test) is not None:
+                chosen = statement.body if _constant_truth(statement.test) else statement.orelse
+                kept += self._statements(chosen, required=False)
+                continue
+            if (isinstance(statement, ast.While) and _constant_truth(statement.test) is False) or (
+                isinstance(statement, ast.For | ast.AsyncFor) and _empty_display(statement.iter)
+            ):
+                kept += self._statements(statement.orelse, required=False)
+                continue
+            kept.append(self.visit(statement))
+            if isinstance(statement, ast.Return | ast.Raise | ast.Break | ast.Continue):
+                break
+        return kept or ([ast.Pass()] if required else [])
+
+    def generic_visit(self, node):
+        scope = isinstance(node, (ast.ClassDef, *_SCOPES))
+        if scope:
+            self.in_class.append(isinstance(node, ast.ClassDef))
+            self.depth += 1
+        try:
+            for field, value in ast.iter_fields(node):
+                if isinstance(value, list) and value and all(isinstance(v, ast.stmt) for v in value):
+                    required = field != "orelse" and not isinstance(node, ast.Module)
+                    setattr(node, field, self._statements(value, required))
+                elif isinstance(value, list):
+                    for child in value:
+                        if isinstance(child, ast.AST):
+                            self.visit(child)
+                elif isinstance(value, ast.AST):
+                    self.visit(value)
+        finally:
+            if scope:
+                self.in_class.pop()
+                self.depth -= 1
+        return node
+
+
+def comparable(text):
+    """``text`` as the report compares it: parsed and written back (comments and layout gone) without
+    the statements that do nothing (the module's docstring), again until none is left; ``text``
+    itself if Python cannot parse it or write it back (a syntax error, or a nesting deep enough
+    to exhaust the parser: ``MemoryError`` on Python 3.11)."""
+    try:
+        tree = ast.parse(text)
+        written = None
+        for _ in range(DEAD_CODE_ROUNDS):
+            tree = _DeadCode(_read_names(tree)).visit(tree)
+            previous, written = written, ast.unparse(tree)
+            if written == previous:
+                break
+        return written
+    except Exception:  # whatever the parser or the writer cannot take: compared as it is
+        return text
