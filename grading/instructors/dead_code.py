@@ -14,7 +14,8 @@ gone. What it drops:
   displays of them; a docstring too); ``assert`` on a true constant;
   ``global`` and ``nonlocal``;
 - a block under a constant test: ``if 0:`` (its ``else`` kept), ``if 1:``
-  (its body kept), ``while 0:``, ``for _ in ():`` (their ``else`` kept);
+  (its body kept), ``while 0:``, ``for _ in ():`` (their ``else`` kept); an
+  ``if``, ``while``, ``for`` or ``try`` left with nothing to do (:func:`_does_nothing`);
 - what follows a ``return``, ``raise``, ``break`` or ``continue`` in its block;
 - a store into names the module never reads, or reads only to store into
   themselves (``_ = 0``, ``x = x``, ``k = k + 1`` and nowhere else); a store
@@ -101,6 +102,23 @@ def _empty_display(node):
     )
 
 
+def _empty(block):
+    return all(isinstance(statement, ast.Pass) for statement in block)
+
+
+def _does_nothing(statement):
+    """Whether a compound statement, its blocks cleaned, is left with nothing to do: an ``if`` or
+    ``while`` on a pure test, a ``for`` over a pure iterable, a ``try`` without ``finally``, each
+    with every block empty (``if __name__ is None: pass``, a hostile review's padding, h47)."""
+    if isinstance(statement, ast.If | ast.While):
+        return _pure(statement.test) and _empty(statement.body) and _empty(statement.orelse)
+    if isinstance(statement, ast.For | ast.AsyncFor):
+        return _pure(statement.iter) and _empty(statement.body) and _empty(statement.orelse)
+    if isinstance(statement, ast.Try | ast.TryStar):
+        return _empty(statement.body) and not statement.finalbody
+    return False
+
+
 class _DeadCode(ast.NodeTransformer):
     """One pass of :func:`comparable`: every block without its dead statements (the module's docstring).
 
@@ -169,7 +187,10 @@ class _DeadCode(ast.NodeTransformer):
             ):
                 kept += self._statements(statement.orelse, required=False)
                 continue
-            kept.append(self.visit(statement))
+            statement = self.visit(statement)
+            if _does_nothing(statement):
+                continue
+            kept.append(statement)
             if isinstance(statement, ast.Return | ast.Raise | ast.Break | ast.Continue):
                 break
         return kept or ([ast.Pass()] if required else [])

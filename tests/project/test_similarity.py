@@ -138,6 +138,7 @@ PADDING = {
     # the copy to 15 %; a name read only by its own stores or deleted, to 29 %.
     "pure expressions": ["-1", "()", "points.shape", "assert 1", "global _g"],
     "blocks that run never or always": ["if 1:\n    pass", "while 0:\n    _ = 1", "for _ in ():\n    pass"],
+    "blocks that do nothing": ["if __name__ is None:\n    pass", "try:\n    pass\nexcept Exception:\n    pass"],
     "self-reads and deletions": ["_k = _k + 1", "_ = 0", "del _", "import os", "def _():\n    return 0"],
 }
 
