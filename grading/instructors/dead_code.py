@@ -108,14 +108,14 @@ def _empty(block):
 
 def _does_nothing(statement):
     """Whether a compound statement, its blocks cleaned, is left with nothing to do: an ``if`` or
-    ``while`` on a pure test, a ``for`` over a pure iterable, a ``try`` without ``finally``, each
+    ``while`` on a pure test, a ``for`` over a pure iterable, a ``try`` without ``else`` or ``finally``, each
     with every block empty (``if __name__ is None: pass``, a hostile review's padding, h47)."""
     if isinstance(statement, ast.If | ast.While):
         return _pure(statement.test) and _empty(statement.body) and _empty(statement.orelse)
     if isinstance(statement, ast.For | ast.AsyncFor):
         return _pure(statement.iter) and _empty(statement.body) and _empty(statement.orelse)
     if isinstance(statement, ast.Try | ast.TryStar):
-        return _empty(statement.body) and not statement.finalbody
+        return _empty(statement.body) and _empty(statement.orelse) and not statement.finalbody
     return False
 
 
