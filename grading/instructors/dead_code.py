@@ -11,8 +11,10 @@ gone. What it drops:
 
 - ``pass``; an expression statement whose evaluation has no effect
   (:func:`_pure`: constants, names, operators, attributes, subscripts,
-  displays of them; a docstring too); ``assert`` on a true constant;
-  ``global`` and ``nonlocal``;
+  displays of them; a docstring too; calls of pure functions,
+  :func:`_pure_callees`: ``abs(0)``, ``len(points)``, ``np.sqrt(x)``
+  without ``out=``, a module function that only returns a pure value);
+  ``assert`` on a true constant; ``global`` and ``nonlocal``;
 - a block under a constant test: ``if 0:`` (its ``else`` kept), ``if 1:``
   (its body kept), ``while 0:``, ``for _ in ():`` (their ``else`` kept); an
   ``if``, ``while``, ``for`` or ``try`` left with nothing to do (:func:`_does_nothing`);
@@ -27,7 +29,9 @@ gone. What it drops:
 
 A class's attributes are read as attributes, never as names: stores in a
 class body are kept. Names read only through ``eval``, ``globals()`` or
-``locals()`` are taken as unread: the report compares, it does not run.
+``locals()`` are taken as unread, and a builtin or NumPy function is taken
+for itself unless the module binds its name: the report compares, it does
+not run.
 """
 
 import ast
@@ -39,29 +43,153 @@ DEAD_CODE_ROUNDS = 5  # passes of comparable(): a dead store feeding a dead stor
 _STORES = (ast.Assign, ast.AugAssign, ast.AnnAssign)
 _SCOPES = (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)
 
+# Builtins whose call computes a value and does nothing else, whatever their (pure) arguments.
+PURE_BUILTINS = frozenset(
+    "abs bin bool callable chr complex divmod enumerate float format hash hex id int isinstance "
+    "issubclass iter len oct ord pow range repr reversed round slice str type zip".split()
+)
+# Builtins that consume an iterable argument (an iterator is used up): pure on displays and constants only.
+CONSUMING_BUILTINS = frozenset("all any dict frozenset list max min set sorted sum tuple".split())
+# NumPy functions that return a new value (``out=`` makes any of them write: then not pure).
+PURE_NUMPY = frozenset(
+    "abs absolute all amax amin any arange argmax argmin argsort array asarray ceil clip concatenate "
+    "copy cos cumsum diag dot empty empty_like exp eye float64 floor full hstack hypot int64 isfinite "
+    "isnan linspace log matmul max maximum mean min minimum ndim ones ones_like round shape sin size "
+    "sort sqrt square stack std sum var vstack where zeros zeros_like".split()
+)
 
-def _pure(node):
-    """Whether evaluating the expression ``node`` has no effect to speak of (no call, no walrus,
-    no yield): a constant, a name, an operator, an attribute or subscript, a display of them."""
+
+def _pure(node, callees=frozenset()):
+    """Whether evaluating the expression ``node`` has no effect to speak of (no walrus, no yield,
+    no call but of ``callees``' pure functions, :func:`_pure_callees`): a constant, a name, an
+    operator, an attribute or subscript, a display of them."""
     if node is None or isinstance(node, ast.Constant | ast.Name | ast.Lambda):
         return True
     if isinstance(node, ast.UnaryOp):
-        return _pure(node.operand)
+        return _pure(node.operand, callees)
     if isinstance(node, ast.BinOp):
-        return _pure(node.left) and _pure(node.right)
+        return _pure(node.left, callees) and _pure(node.right, callees)
     if isinstance(node, ast.BoolOp):
-        return all(_pure(value) for value in node.values)
+        return all(_pure(value, callees) for value in node.values)
     if isinstance(node, ast.Compare):
-        return _pure(node.left) and all(_pure(c) for c in node.comparators)
+        return _pure(node.left, callees) and all(_pure(c, callees) for c in node.comparators)
     if isinstance(node, ast.Tuple | ast.List | ast.Set):
-        return all(_pure(element) for element in node.elts)
+        return all(_pure(element, callees) for element in node.elts)
     if isinstance(node, ast.Attribute):
-        return _pure(node.value)
+        return _pure(node.value, callees)
     if isinstance(node, ast.Subscript):
-        return _pure(node.value) and _pure(node.slice)
+        return _pure(node.value, callees) and _pure(node.slice, callees)
     if isinstance(node, ast.Slice):
-        return _pure(node.lower) and _pure(node.upper) and _pure(node.step)
+        return _pure(node.lower, callees) and _pure(node.upper, callees) and _pure(node.step, callees)
+    if isinstance(node, ast.Call):
+        return _pure_call(node, callees)
     return False
+
+
+def _callee(func):
+    """``abs`` for ``abs(...)``, ``np.sqrt`` for ``np.sqrt(...)``; None for any other callee."""
+    if isinstance(func, ast.Name):
+        return func.id
+    if isinstance(func, ast.Attribute) and isinstance(func.value, ast.Name):
+        return f"{func.value.id}.{func.attr}"
+    return None
+
+
+def _literal(node):
+    """A constant, or a display of constants (nothing an iterator could hide behind)."""
+    if isinstance(node, ast.Constant):
+        return True
+    if isinstance(node, ast.Tuple | ast.List | ast.Set):
+        return all(_literal(element) for element in node.elts)
+    return isinstance(node, ast.UnaryOp) and _literal(node.operand)
+
+
+def _pure_call(node, callees):
+    name = _callee(node.func)
+    if name is None or any(isinstance(a, ast.Starred) for a in node.args):
+        return False
+    keywords = {keyword.arg for keyword in node.keywords}
+    if None in keywords or "out" in keywords:  # **kwargs, or a result written into an array
+        return False
+    arguments = [*node.args, *(keyword.value for keyword in node.keywords)]
+    if not all(_pure(argument, callees) for argument in arguments):
+        return False
+    if name == "print" and "print" in callees:  # print(end=''): writes nothing
+        end = next((k.value for k in node.keywords if k.arg == "end"), None)
+        return not node.args and keywords <= {"end", "sep", "flush"} and _literal(end) and end.value == ""
+    if name in CONSUMING_BUILTINS:
+        return name in callees and all(_literal(argument) for argument in arguments)
+    return name in callees
+
+
+def _bound_names(tree):
+    """Every name ``tree`` binds anywhere: stores, definitions, imports, arguments."""
+    bound = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Name) and not isinstance(node.ctx, ast.Load):
+            bound.add(node.id)
+        elif isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef | ast.ClassDef):
+            bound.add(node.name)
+        elif isinstance(node, ast.Import | ast.ImportFrom):
+            bound |= {(alias.asname or alias.name).split(".")[0] for alias in node.names}
+        elif isinstance(node, ast.arg):
+            bound.add(node.arg)
+        elif isinstance(node, ast.ExceptHandler) and node.name:
+            bound.add(node.name)
+    return bound
+
+
+def _returns_only_pure(function, callees):
+    """Whether calling ``function`` only computes a value: its body stores into its own plain
+    names, returns, or evaluates, each a pure expression."""
+    if function.decorator_list or isinstance(function, ast.AsyncFunctionDef):
+        return False
+    for statement in function.body:
+        if isinstance(statement, ast.Pass):
+            continue
+        if isinstance(statement, ast.Return | ast.Expr):
+            if not _pure(statement.value, callees):
+                return False
+        elif isinstance(statement, ast.Assign):
+            if not all(isinstance(t, ast.Name) for t in statement.targets) or not _pure(statement.value, callees):
+                return False
+        else:
+            return False
+    return True
+
+
+def _pure_callees(tree):
+    """The callees whose call has no effect in the module ``tree``: builtins (:data:`PURE_BUILTINS`,
+    :data:`CONSUMING_BUILTINS`, ``print``) and NumPy's (:data:`PURE_NUMPY`, through ``import numpy
+    as np``) whose names the module does not bind otherwise, and its own functions (each name
+    defined once, bound nowhere else) that only return pure values (:func:`_returns_only_pure`,
+    to a fixed point: one may call another)."""
+    bound = _bound_names(tree)
+    callees = {name for name in PURE_BUILTINS | CONSUMING_BUILTINS | {"print"} if name not in bound}
+    imported = [
+        (alias.asname or alias.name.split(".")[0], alias.name if isinstance(node, ast.Import) else None)
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Import | ast.ImportFrom)
+        for alias in node.names
+    ]
+    stores = [n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load)]
+    definitions = [node for node in ast.walk(tree) if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)]
+    arguments = {a.arg for a in ast.walk(tree) if isinstance(a, ast.arg)}
+    otherwise = set(stores) | arguments | {d.name for d in definitions}
+    for alias in {alias for alias, module in imported if module == "numpy"} - otherwise:
+        if all(module == "numpy" for other, module in imported if other == alias):  # np is numpy alone
+            callees |= {f"{alias}.{name}" for name in PURE_NUMPY}
+    other = set(stores) | arguments | {alias for alias, _ in imported}
+    once = {d.name for d in definitions if sum(e.name == d.name for e in definitions) == 1} - other
+    changed = True
+    while changed:
+        changed = False
+        for definition in definitions:
+            if definition.name in once and definition.name not in callees:
+                if _returns_only_pure(definition, frozenset(callees)):
+                    callees.add(definition.name)
+                    changed = True
+    return frozenset(callees)
 
 
 def _stored_names(targets):
@@ -106,14 +234,14 @@ def _empty(block):
     return all(isinstance(statement, ast.Pass) for statement in block)
 
 
-def _does_nothing(statement):
+def _does_nothing(statement, callees):
     """Whether a compound statement, its blocks cleaned, is left with nothing to do: an ``if`` or
     ``while`` on a pure test, a ``for`` over a pure iterable, a ``try`` without ``else`` or ``finally``, each
     with every block empty (``if __name__ is None: pass``, a hostile review's padding, h47)."""
     if isinstance(statement, ast.If | ast.While):
-        return _pure(statement.test) and _empty(statement.body) and _empty(statement.orelse)
+        return _pure(statement.test, callees) and _empty(statement.body) and _empty(statement.orelse)
     if isinstance(statement, ast.For | ast.AsyncFor):
-        return _pure(statement.iter) and _empty(statement.body) and _empty(statement.orelse)
+        return _pure(statement.iter, callees) and _empty(statement.body) and _empty(statement.orelse)
     if isinstance(statement, ast.Try | ast.TryStar):
         return _empty(statement.body) and _empty(statement.orelse) and not statement.finalbody
     return False
@@ -126,10 +254,13 @@ class _DeadCode(ast.NodeTransformer):
     ----------
     read : set of str
         The names the module reads (:func:`_read_names`).
+    callees : frozenset of str
+        The functions whose calls have no effect (:func:`_pure_callees`).
     """
 
-    def __init__(self, read):
+    def __init__(self, read, callees=frozenset()):
         self.read = read
+        self.callees = callees
         self.in_class = [False]  # whether the innermost scope is a class body
         self.depth = 0  # 0: the module's own statements
 
@@ -151,7 +282,7 @@ class _DeadCode(ast.NodeTransformer):
             return statement
         if not self._unread(_stored_names(targets)):
             return statement
-        return None if _pure(value) else ast.Expr(value)
+        return None if _pure(value, self.callees) else ast.Expr(value)
 
     def _unused_definition(self, statement):
         """Whether ``statement`` defines only names nobody reads: an import anywhere, a function or
@@ -174,7 +305,7 @@ class _DeadCode(ast.NodeTransformer):
                 continue
             if isinstance(statement, ast.Pass | ast.Global | ast.Nonlocal):
                 continue
-            if isinstance(statement, ast.Expr) and _pure(statement.value):
+            if isinstance(statement, ast.Expr) and _pure(statement.value, self.callees):
                 continue
             if isinstance(statement, ast.Assert) and _constant_truth(statement.test) is True:
                 continue
@@ -188,7 +319,7 @@ class _DeadCode(ast.NodeTransformer):
                 kept += self._statements(statement.orelse, required=False)
                 continue
             statement = self.visit(statement)
-            if _does_nothing(statement):
+            if _does_nothing(statement, self.callees):
                 continue
             kept.append(statement)
             if isinstance(statement, ast.Return | ast.Raise | ast.Break | ast.Continue):
@@ -227,7 +358,7 @@ def comparable(text):
         tree = ast.parse(text)
         written = None
         for _ in range(DEAD_CODE_ROUNDS):
-            tree = _DeadCode(_read_names(tree)).visit(tree)
+            tree = _DeadCode(_read_names(tree), _pure_callees(tree)).visit(tree)
             previous, written = written, ast.unparse(tree)
             if written == previous:
                 break

@@ -7,6 +7,7 @@ rank first, the independent solutions must stay below the display
 threshold, and the stub's own text must never make a pair.
 """
 
+import ast
 import base64
 import dataclasses
 import importlib.util
@@ -140,14 +141,17 @@ PADDING = {
     "blocks that run never or always": ["if 1:\n    pass", "while 0:\n    _ = 1", "for _ in ():\n    pass"],
     "blocks that do nothing": ["if __name__ is None:\n    pass", "try:\n    pass\nexcept Exception:\n    pass"],
     "self-reads and deletions": ["_k = _k + 1", "_ = 0", "del _", "import os", "def _():\n    return 0"],
+    # A hostile review (h47d): abs(0) after every statement, 37 %; print(end=''), 35 %.
+    "pure calls": ["abs(0)", "len(points)", "np.sqrt(4.0)", "print(end='')", "_zero()", "_ = _zero()"],
 }
+PREAMBLE = {"pure calls": ["def _zero():", "    return abs(0)"]}  # a function of the module's own, pure
 
 
 @pytest.mark.parametrize("padding", sorted(PADDING))
 def test_statements_that_do_nothing_hide_no_copy(padding, tmp_path):
     """A hostile review (h46): ``pass`` after every statement broke every 25-token run the copy shared
     (100 % -> 24 %, under the threshold and below two independent students); so did ``_ = 0``."""
-    padded = ["if False:", "    raise RuntimeError('never')", "junk = 0", "_k = 0"]
+    padded = ["if False:", "    raise RuntimeError('never')", "junk = 0", "_k = 0", *PREAMBLE.get(padding, [])]
     for line in textwrap.dedent(ALICE).strip().splitlines():
         indent = line[: len(line) - len(line.lstrip())]
         pad = [textwrap.indent(statement, indent) for statement in PADDING[padding]]
@@ -166,6 +170,22 @@ def test_statements_that_do_nothing_hide_no_copy(padding, tmp_path):
     assert {first.first, first.second} == {"alice", "mallory"} and first.similarity > 0.9, first
     others = [(p.first, p.second, round(p.similarity, 2)) for p in pairs[1:]]
     assert all(p.similarity < DISPLAY_THRESHOLD for p in pairs[1:]), others
+
+
+@pytest.mark.parametrize(
+    "kept",
+    [
+        "def abs(x):\n    print(x)\n\ndef f():\n    abs(0)",  # a builtin's name bound by the module
+        "import numpy as np\n\ndef f(p):\n    np.sqrt(p, out=p)",  # written into an array
+        "def f(it):\n    list(it)",  # an iterator used up
+        "def f():\n    print('x')",
+        "def _log(x):\n    print(x)\n    return x\n\ndef f():\n    _log(1)",  # a function with an effect
+    ],
+)
+def test_a_call_that_may_have_an_effect_is_kept(kept):
+    from grading.instructors.dead_code import comparable
+
+    assert comparable(kept).strip() == ast.unparse(ast.parse(kept)).strip()
 
 
 def test_a_module_the_parser_cannot_take_is_compared_as_it_is():
