@@ -49,7 +49,7 @@ from grading.sandbox.processes import (
     stat_of,
 )
 from grading.sandbox.usage import CallUsage
-from grading.sandbox.walls import BUBBLEWRAP, UID, isolation, remove_files_of, rules_uid
+from grading.sandbox.walls import BUBBLEWRAP, UID, isolation, remove_files_of, rule_sets, rules_uid
 
 
 class Worker:
@@ -178,11 +178,11 @@ class Worker:
 
     def _uids(self):
         """The sandbox uids this worker may run as: its slot's, and as a dedicated uid without
-        namespaces the slot's second uid, for the modules with rules of their own."""
+        namespaces the slot's uid of each set of rules, for the modules with rules of their own."""
         base = self.isolation.uid
         if base is None:
             return []
-        return [base, rules_uid(base, True)] if self.isolation.level == UID else [base]
+        return [base, *(rules_uid(base, extra) for extra in rule_sets())] if self.isolation.level == UID else [base]
 
     def _leftovers(self):
         if self.uid is not None:

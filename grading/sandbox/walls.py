@@ -118,29 +118,62 @@ def make_reachable(path):
             os.chmod(parent, stat.S_IMODE(mode) | stat.S_IXOTH)
 
 
+def rule_sets():
+    """The distinct sets of names the modules' own rules forbid (``FORBIDDEN_IN_MODULE``'s values,
+    in order, each a tuple): set g (0, 1, ...) runs as its slot's uid ``g + 1`` blocks of
+    :data:`grading.config.SANDBOX_UID_SLOTS` above the slot's own (:func:`rules_uid`)."""
+    return list(dict.fromkeys(tuple(names) for names in config.FORBIDDEN_IN_MODULE.values()))
+
+
+def sandbox_uid_count():
+    """How many sandbox uids there are: a block of slots for the modules without rules of their
+    own, and one for each set of rules (:func:`rule_sets`)."""
+    return (1 + len(rule_sets())) * config.SANDBOX_UID_SLOTS
+
+
 def rules_uid(uid, extra):
     """The uid that runs a module with forbidden names of its own (``extra``, such as
-    ``scipy.spatial`` in ``nn.py``) in the slot of sandbox ``uid``: the slot's second uid,
-    :data:`grading.config.SANDBOX_UID_SLOTS` above it, which ACLs bar from those packages too
-    (:func:`isolation`); ``uid`` itself for a module without rules of its own."""
-    return uid + config.SANDBOX_UID_SLOTS if uid is not None and extra else uid
+    ``scipy.spatial`` in ``nn.py``) in the slot of sandbox ``uid``: that set of rules' uid of the
+    slot (:func:`rule_sets`), which ACLs bar from those packages too (:func:`isolation`), and
+    from no other module's (``cluster.py`` may use ``scipy.spatial``); ``uid`` itself for a
+    module without rules of its own."""
+    if uid is None or not extra:
+        return uid
+    return uid + (1 + rule_sets().index(tuple(extra))) * config.SANDBOX_UID_SLOTS
 
 
-def module_rules_paths():
-    """Every entry the modules' own rules forbid (``FORBIDDEN_IN_MODULE``) on top of the
-    packages forbidden everywhere."""
+def module_rules_paths(extra):
+    """The entries the forbidden names ``extra`` (one module's own rules) add to the packages
+    forbidden everywhere."""
     everywhere = set(masked_paths())
-    extra = tuple(sorted({name for names in config.FORBIDDEN_IN_MODULE.values() for name in names}))
-    return [path for path in masked_paths(extra) if path not in everywhere]
+    return [path for path in masked_paths(tuple(extra)) if path not in everywhere]
 
 
 def bar_forbidden_packages():
-    """Bar every sandbox uid from the packages forbidden everywhere, and the slots' second uids
-    (:func:`rules_uid`) from those the modules' own rules forbid too; None when done, else why not."""
+    """Bar every sandbox uid from the packages forbidden everywhere, and each set of rules' uids
+    (:func:`rules_uid`) from the packages that set forbids too; None when done, else why not."""
     barred = bar_sandbox_uids(masked_paths())
-    if barred is None:
-        second = config.SANDBOX_UID_BASE + config.SANDBOX_UID_SLOTS
-        barred = bar_sandbox_uids(module_rules_paths(), range(second, second + config.SANDBOX_UID_SLOTS))
+    # A uid of a set of rules loses what an earlier set barred it from (ACLs stay on the files: a
+    # course whose modules' rules changed, on the same environment), never what its own set bars:
+    # no moment leaves a package open to a uid its rules bar from it.
+    sets = {extra: rules_uid(config.SANDBOX_UID_BASE, extra) for extra in rule_sets()}
+    every = {uid for first in sets.values() for uid in range(first, first + config.SANDBOX_UID_SLOTS)}
+    stale = {}
+    for path in {path for extra in sets for path in module_rules_paths(extra)}:
+        kept = {
+            uid
+            for extra, first in sets.items()
+            if path in module_rules_paths(extra)
+            for uid in range(first, first + config.SANDBOX_UID_SLOTS)
+        }
+        stale.setdefault(tuple(sorted(every - kept)), []).append(path)
+    for uids, paths in sorted(stale.items()):
+        if barred is None and uids:
+            barred = _setfacl(["-x", ",".join(f"u:{uid}" for uid in uids)], sorted(paths))
+    for extra in rule_sets():
+        if barred is None:
+            first = rules_uid(config.SANDBOX_UID_BASE, extra)
+            barred = bar_sandbox_uids(module_rules_paths(extra), range(first, first + config.SANDBOX_UID_SLOTS))
     return barred
 
 
@@ -158,12 +191,18 @@ def bar_sandbox_uids(paths, also_barred_from=None):
         return None
     if not shutil.which("setfacl"):
         return "setfacl is not installed, to bar the sandbox uids from the forbidden packages (apt-get install acl)"
-    uids = range(config.SANDBOX_UID_BASE, config.SANDBOX_UID_BASE + 2 * config.SANDBOX_UID_SLOTS)
+    uids = range(config.SANDBOX_UID_BASE, config.SANDBOX_UID_BASE + sandbox_uid_count())
     if also_barred_from is not None:
         uids = also_barred_from
-    entries = ",".join(f"u:{uid}:---" for uid in uids)
+    return _setfacl(["-m", ",".join(f"u:{uid}:---" for uid in uids)], paths)
+
+
+def _setfacl(change, paths):
+    """``setfacl -P <change> -- paths``: None when done, else why not (one line)."""
+    if not paths:
+        return None
     completed = subprocess.run(
-        ["setfacl", "-P", "-m", entries, "--", *[str(p) for p in paths]], capture_output=True, text=True
+        ["setfacl", "-P", *change, "--", *[str(p) for p in paths]], capture_output=True, text=True
     )
     if completed.returncode != 0:
         why = (completed.stderr.strip().splitlines() or ["?"])[-1]
@@ -415,8 +454,11 @@ def isolation(uid=None):
     if barred is not None:
         return Isolation(NONE, None, f"{why_not}; {barred}")
     wall = permission_wall(uid, [*protected_paths(), *masked_paths()])
-    if wall is None:
-        wall = permission_wall(rules_uid(uid, True), [*protected_paths(), *masked_paths(), *module_rules_paths()])
+    for extra in rule_sets():
+        if wall is None:
+            wall = permission_wall(
+                rules_uid(uid, extra), [*protected_paths(), *masked_paths(), *module_rules_paths(extra)]
+            )
     if wall is not None:
         return Isolation(NONE, None, f"{why_not}; {wall}")
     network = network_wall(uid)

@@ -72,6 +72,16 @@ def plain(points):
     return points.sum()
 
 
+def visible(folders):
+    # Which of SciPy's subpackages this module's process can see (masked: an empty folder;
+    # barred by an ACL: no access).
+    import os
+
+    import scipy
+
+    return [os.path.exists(os.path.join(os.path.dirname(scipy.__file__), f, '__init__.py')) for f in folders]
+
+
 import shutil  # noqa: E402
 '''
 
@@ -84,6 +94,35 @@ def allowed(points):
     return cKDTree(points).query(points[:1], k=2)[1]
 '''
 
+CLUSTER = '''
+import importlib
+import sys
+
+from scipy.spatial import cKDTree
+
+
+def allowed(points):
+    """Lecture 3 may use scipy.spatial (nn.py's own rule does not bind it)."""
+    return cKDTree(points).query(points[:1], k=2)[1]
+
+
+def computed(points):
+    """scipy.cluster by a computed name, with the worker's own import finder removed first."""
+    sys.meta_path[:] = [f for f in sys.meta_path if "Forbidden" not in type(f).__name__]
+    vq = importlib.import_module("scipy." + "clus" + "ter.vq")
+    return vq.vq(points, points[:2])[0][:2]
+
+
+def visible(folders):
+    # Which of SciPy's subpackages this module's process can see (masked: an empty folder;
+    # barred by an ACL: no access).
+    import os
+
+    import scipy
+
+    return [os.path.exists(os.path.join(os.path.dirname(scipy.__file__), f, '__init__.py')) for f in folders]
+'''
+
 
 def worker(tmp_path, level, timeout=20):
     package = tmp_path / "clone" / "pcl_course"
@@ -91,12 +130,31 @@ def worker(tmp_path, level, timeout=20):
     (package / "__init__.py").write_text("")
     (package / "nn.py").write_text(textwrap.dedent(NN))
     (package / "pca.py").write_text(textwrap.dedent(PCA))
+    (package / "cluster.py").write_text(textwrap.dedent(CLUSTER))
     isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
     return Worker(stage(package).root, timeout=timeout, level=isolated)
 
 
 POINTS = np.random.default_rng(3).random((40, 3))
 NEAREST_TWO = [0, int(np.argsort(((POINTS - POINTS[0]) ** 2).sum(axis=1))[1])]
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_each_modules_own_rules_bind_that_module_only(tmp_path, level):
+    """Two modules with rules of their own (nn.py: scipy.spatial; cluster.py: scipy.cluster) run
+    each barred from its own set, not from the other's: as dedicated uids, each set has its uids."""
+    if level == "uid":
+        assert bar_forbidden_packages() is None
+    impl = worker(tmp_path, level)
+    try:
+        assert list(impl.call("cluster", "allowed", (POINTS,), {})[0]) == NEAREST_TWO
+        with pytest.raises((ForbiddenAPI, AttributeError, ImportError)):
+            impl.call("cluster", "computed", (POINTS,), {})
+        seen = {module: impl.call(module, "visible", (["spatial", "cluster"],), {}) for module in ("nn", "cluster")}
+        assert seen == {"nn": [False, True], "cluster": [True, False]}, seen
+        assert list(impl.call("cluster", "allowed", (POINTS,), {})[0]) == NEAREST_TWO
+    finally:
+        impl.close()
 
 
 @pytest.mark.parametrize("level", LEVELS)
@@ -342,3 +400,26 @@ def test_the_rules_uid_finds_nothing_the_slots_other_uid_left(tmp_path):
         impl.close()
         if os.path.exists(name):
             os.unlink(name)
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or not shutil.which("getfacl"), reason="ACLs need root")
+def test_a_rules_uid_barred_by_an_earlier_set_of_rules_is_let_through():
+    """ACLs stay on the files: a uid barred from scipy.spatial when every module with rules shared
+    one uid (the previous design) could not import it for cluster.py, which may."""
+    from grading import config
+    from grading.sandbox.walls import bar_sandbox_uids, module_rules_paths, rule_sets, rules_uid
+
+    nn_rules, cluster_rules = (config.FORBIDDEN_IN_MODULE[m] for m in ("nn", "cluster"))
+    spatial = module_rules_paths(nn_rules)
+    cluster_uid = rules_uid(config.SANDBOX_UID_BASE, cluster_rules)
+    assert rule_sets().index(tuple(cluster_rules)) > 0 and spatial
+    assert bar_sandbox_uids(spatial, [cluster_uid]) is None  # the stale entry
+
+    def entries(path):
+        listed = subprocess.run(["getfacl", "-p", "-n", str(path)], capture_output=True, text=True).stdout
+        return {line.split(":")[1] for line in listed.splitlines() if line.startswith("user:") and line.split(":")[1]}
+
+    assert str(cluster_uid) in entries(spatial[0])
+    assert bar_forbidden_packages() is None
+    assert str(cluster_uid) not in entries(spatial[0])
+    assert str(rules_uid(config.SANDBOX_UID_BASE, nn_rules)) in entries(spatial[0])
