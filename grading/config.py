@@ -9,7 +9,8 @@ import os
 # -- what is graded -------------------------------------------------------------
 # One assignment per lecture, each its own Gradescope assignment (its own
 # archive and total): graded function -> exercise module, every name in
-# ../shared/course-api.md (lecture 1) or in pcl_course/nn.py's contract (lecture 2).
+# ../shared/course-api.md (lecture 1) or in pcl_course/nn.py's and pcl_course/cluster.py's
+# contracts (lectures 2 and 3).
 ASSIGNMENTS = {
     "lecture1": {
         "pca": "pca",
@@ -41,6 +42,10 @@ ASSIGNMENTS = {
         "octree_radius": "nn",
         "octree_knn": "nn",
     },
+    "lecture3": {
+        "kmeans": "cluster",
+        "kmeans_plusplus": "cluster",
+    },
 }
 GRADED_FUNCTIONS = {function: module for graded in ASSIGNMENTS.values() for function, module in graded.items()}
 EXERCISE_MODULES = tuple(dict.fromkeys(GRADED_FUNCTIONS.values()))  # pcl_course/<module>.py
@@ -57,7 +62,11 @@ ASSIGNMENT_NUMBERS = {function: i + 1 for i, graded in enumerate(ASSIGNMENTS.val
 # release's README (grading/templates/README.md's title) must agree with them:
 # tests/project/test_labels.py checks they do.
 COURSE_TITLE = "3D Point Cloud Processing"
-LECTURES = {"lecture1": "PCA, normals, downsampling and filters", "lecture2": "Nearest neighbours"}
+LECTURES = {
+    "lecture1": "PCA, normals, downsampling and filters",
+    "lecture2": "Nearest neighbours",
+    "lecture3": "Clustering",
+}
 # Complete helper modules of pcl_course: they may use Open3D (data sets) and
 # are not exercises. A submission's copy is trusted only if it is unchanged.
 HELPER_MODULES = ("__init__", "validation", "neighbors", "datasets", "io", "plotting", "book")
@@ -115,9 +124,10 @@ STDERR_TAIL_BYTES = 64 * 1024  # of the worker's stderr, read from its end after
 
 # The dedicated, unprivileged uids that run submissions when the grader is
 # root: one per parallel job slot of `batch`, never shared with another
-# account; and, without namespaces, a second one per slot (SANDBOX_UID_SLOTS
-# above it) for the modules with rules of their own (FORBIDDEN_IN_MODULE),
-# which ACLs bar from those packages too: 2 * SANDBOX_UID_SLOTS uids in all.
+# account; and, without namespaces, one more per slot for each set of rules of
+# the modules' own (FORBIDDEN_IN_MODULE; a block of SANDBOX_UID_SLOTS uids
+# each, above the slots'), which ACLs bar from that set's packages too:
+# (1 + sets) * SANDBOX_UID_SLOTS uids in all (grading/sandbox/walls.py).
 # Override the base with PCL_SANDBOX_UID (e.g. on a machine where these uids
 # are taken).
 SANDBOX_UID_BASE = int(os.environ.get("PCL_SANDBOX_UID", "60500"))
@@ -154,6 +164,9 @@ FORBIDDEN_IN_MODULE = {
         "kdtree",
         "pcl_course.neighbors",
     ),
+    # The clustering lecture is about writing the algorithms (scikit-learn's and Open3D's are
+    # forbidden everywhere already).
+    "cluster": ("scipy.cluster", "hdbscan", "fast_hdbscan", "dbscan", "pyclustering", "kmeans1d", "faiss"),
 }
 
 # -- the instructors' reports (grading/instructors/) -------------------------------

@@ -4,7 +4,8 @@ Exercise modules (implement the stubs), by lecture:
 
 - lecture 1, PCA, normals, downsampling and filters: :mod:`pca`,
   :mod:`normals`, :mod:`downsampling`, :mod:`filters`, :mod:`metrics`;
-- lecture 2, nearest neighbours: :mod:`nn`.
+- lecture 2, nearest neighbours: :mod:`nn`;
+- lecture 3, clustering: :mod:`cluster`.
 
 Complete helpers (use them): :mod:`validation`, :mod:`datasets`, :mod:`io`,
 :mod:`neighbors`, :mod:`plotting`, :mod:`book`; :func:`check` grades an

@@ -1,0 +1,133 @@
+"""Exercises of lecture 3: clustering (k-means and its seeding).
+
+The rules of this module (the course's contract, on top of the general rules):
+
+Points and distances
+    ``points`` is (N, D), D >= 1, N >= 1; every column is a coordinate.
+    Everything is computed in float64 (float32 input is converted). The
+    squared distance of a point p to a centre c is
+    ``s = sum_j (p_j - c_j) ** 2`` over the columns, in increasing j (as in
+    lecture 2).
+
+Ties
+    Wherever a rule takes a minimum over centres, **ties go to the lowest
+    index**.
+
+Randomness
+    :func:`kmeans` is deterministic: it starts from the centres it is given.
+    Only :func:`kmeans_plusplus` draws, from ``rng`` (``None``, an int seed
+    or a ``numpy.random.Generator``, as ``np.random.default_rng(rng)``),
+    exactly the draws its docstring lists, in that order: the same seed gives
+    the same answer, in every correct submission.
+
+Arguments
+    Anything else than the documented shapes, non-finite values, a number of
+    clusters outside its range or a ``max_iter`` below 1 is a ``ValueError``
+    naming the argument. Inputs are never modified.
+
+Forbidden here
+    scikit-learn and Open3D (forbidden everywhere), and ``scipy.cluster``:
+    this lecture is about writing the algorithms. NumPy, SciPy's other
+    modules (``scipy.spatial.distance.cdist``, ...) and numba are yours.
+"""
+
+# What every solution needs (NumPy; the course's input checks).
+import numpy as np  # noqa: F401
+
+from pcl_course.validation import as_array, as_points, check_integer, check_rng  # noqa: F401
+
+__all__ = ["kmeans", "kmeans_plusplus"]
+
+
+def kmeans(points, init_centers, max_iter=300):
+    """Lloyd's algorithm from the given centres.
+
+    Iteration t = 1, 2, ...:
+
+    1. **Assign** each point to its nearest centre (smallest squared
+       distance, ties to the lowest centre index) and record
+       ``inertia[t - 1]``, the sum over the points of the squared distance
+       to their centre.
+    2. If t > 1 and no label changed from iteration t - 1, **stop**:
+       ``n_iter = t``.
+    3. Otherwise, if t < ``max_iter``, **update** every centre to the mean
+       of its points; **an empty cluster keeps its centre**. If
+       t == ``max_iter``, update the centres the same way, then assign the
+       points to the updated centres once more (not an iteration: nothing
+       is recorded), and stop with ``n_iter = max_iter``.
+
+    So the returned labels are always the assignment to the returned
+    centres, and every returned centre with points is their mean.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+        The points, N >= 1, D >= 1.
+    init_centers : array_like, shape (K, D)
+        The initial centres, 1 <= K <= N, with the width of ``points``.
+        Equal centres are allowed (ties send every point to the first of
+        them; the others start empty).
+    max_iter : int, default 300
+        Largest number of iterations, >= 1.
+
+    Returns
+    -------
+    labels : ndarray of int64, shape (N,)
+        Each point's centre, in ``0 .. K - 1``.
+    centers : ndarray of float64, shape (K, D)
+        The final centres.
+    inertia : ndarray of float64, shape (n_iter,)
+        The sum of squared distances recorded at each iteration's
+        assignment; it never increases.
+    n_iter : int
+        The number of iterations run, ``1 <= n_iter <= max_iter``.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points`` or ``init_centers`` (shape, width, non-finite, K
+        outside ``1..N``); ``max_iter`` not an integer >= 1.
+    """
+    raise NotImplementedError("kmeans: not implemented yet")
+
+
+def kmeans_plusplus(points, n_clusters, rng=None):
+    """The k-means++ seeding (D² sampling) of Arthur and Vassilvitskii.
+
+    ``rng = np.random.default_rng(rng)``, then:
+
+    1. The first index is ``rng.integers(N)``.
+    2. Each next index: let ``w[i]`` be the squared distance of point i to
+       its nearest chosen point (0 for the chosen points and their
+       duplicates), ``cum = np.cumsum(w)`` (in index order) and
+       ``u = rng.random()``; the index is the smallest i with
+       ``cum[i] > u * cum[-1]``. (A point is drawn with probability
+       proportional to ``w``; ``rng.choice(N, p=w / w.sum())`` draws the
+       same way.)
+
+    No other draw is made. Points at distance 0 from a chosen point are
+    never drawn, so the indices are distinct and no two chosen points are
+    equal.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+        The points, N >= 1, D >= 1.
+    n_clusters : int
+        Number of seeds, ``1 <= n_clusters <=`` the number of distinct
+        points.
+    rng : None, int or numpy.random.Generator, default None
+        The source of the draws.
+
+    Returns
+    -------
+    indices : ndarray of int64, shape (n_clusters,)
+        The chosen points' indices, in the order they were drawn.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; ``n_clusters`` not an integer in
+        ``1 ..`` the number of distinct points; a bad ``rng``.
+    """
+    raise NotImplementedError("kmeans_plusplus: not implemented yet")

@@ -1,0 +1,74 @@
+"""Reference: k-means (Lloyd's algorithm) and the k-means++ seeding."""
+
+import numpy as np
+
+from pcl_course.validation import as_array, as_points, check_integer, check_rng
+
+__all__ = ["kmeans", "kmeans_plusplus"]
+
+
+def _squared_distances(points, centers):
+    """Squared distances ``s`` (N, K) of every point to every centre, summed over the columns in
+    increasing order (the contract's order: a tie is a tie in every correct submission)."""
+    s = np.zeros((len(points), len(centers)))
+    for j in range(points.shape[1]):
+        s += np.square(points[:, j, None] - centers[None, :, j])
+    return s
+
+
+def _assign(points, centers):
+    """Each point's nearest centre (ties to the lowest index) and the sum of the squared distances."""
+    s = _squared_distances(points, centers)
+    labels = np.argmin(s, axis=1)  # the first minimum: the lowest index
+    return labels, float(s[np.arange(len(points)), labels].sum())
+
+
+def _means(points, labels, centers):
+    """Each centre moved to the mean of its points (summed in index order); an empty one kept."""
+    counts = np.bincount(labels, minlength=len(centers))
+    sums = np.column_stack(
+        [np.bincount(labels, weights=points[:, j], minlength=len(centers)) for j in range(points.shape[1])]
+    )
+    filled = counts > 0
+    moved = centers.copy()
+    moved[filled] = sums[filled] / counts[filled, None]
+    return moved
+
+
+def kmeans(points, init_centers, max_iter=300):
+    points = as_points(points, min_columns=1, allow_empty=False)
+    centers = as_array(init_centers, "init_centers", ndim=2)
+    if centers.shape[1] != points.shape[1]:
+        raise ValueError(f"init_centers must have {points.shape[1]} columns (the width of points), got {centers.shape}")
+    if not 1 <= len(centers) <= len(points):
+        raise ValueError(f"init_centers must hold 1 to {len(points)} centres (N), got {len(centers)}")
+    max_iter = check_integer(max_iter, "max_iter", low=1)
+    centers = centers.copy()
+    inertia = []
+    previous = None
+    for t in range(1, max_iter + 1):
+        labels, total = _assign(points, centers)
+        inertia.append(total)
+        if previous is not None and np.array_equal(labels, previous):
+            break
+        centers = _means(points, labels, centers)
+        previous = labels
+        if t == max_iter:
+            labels, _ = _assign(points, centers)
+    return labels.astype(np.int64), centers, np.array(inertia), len(inertia)
+
+
+def kmeans_plusplus(points, n_clusters, rng=None):
+    points = as_points(points, min_columns=1, allow_empty=False)
+    distinct = len(np.unique(points, axis=0))
+    n_clusters = check_integer(n_clusters, "n_clusters", low=1)
+    if n_clusters > distinct:
+        raise ValueError(f"n_clusters must be at most the number of distinct points ({distinct}), got {n_clusters}")
+    rng = check_rng(rng)
+    chosen = [int(rng.integers(len(points)))]
+    nearest = _squared_distances(points, points[chosen])[:, 0]
+    for _ in range(n_clusters - 1):
+        cumulative = np.cumsum(nearest)
+        chosen.append(int(np.searchsorted(cumulative, rng.random() * cumulative[-1], side="right")))
+        nearest = np.minimum(nearest, _squared_distances(points, points[chosen[-1:]])[:, 0])
+    return np.array(chosen, dtype=np.int64)

@@ -1,0 +1,357 @@
+"""Graded tests of the clustering exercises (``pcl_course/cluster.py``).
+
+Expected answers come from small clouds worked out by hand, from scikit-learn's
+``KMeans`` started from the same centres (``n_init=1, tol=0``: the same Lloyd
+iterations as the contract's, with the same number of iterations, on clouds
+where no cluster empties, which scikit-learn would relocate), and from the
+tests' own few-line implementations of the contract's rules (the k-means++
+draws, the truncated runs), written from the contract, not from the reference.
+"""
+
+import numpy as np
+import pytest
+from sklearn.cluster import KMeans
+from sklearn.datasets import make_blobs
+
+from grading.checks import CheckFailed, as_list, check_array, check_close, check_unmodified, raises
+
+# Centres are means: another summation order (np.add.at, bincount, a loop) moves them by a few ulps.
+CENTRES_RTOL = 1e-12
+CENTRES_ATOL = 1e-12
+
+
+def _blobs(n=600, centres=4, columns=3, seed=0):
+    points, _ = make_blobs(n, n_features=columns, centers=centres, cluster_std=1.5, random_state=seed)
+    return points
+
+
+def _first_points(points, k, seed):
+    """``k`` distinct points of ``points`` chosen by ``seed``: centres that start with a point each."""
+    return points[np.random.default_rng(seed).choice(len(points), k, replace=False)].copy()
+
+
+def _unpack(result, n, k, d):
+    """The four outputs of ``kmeans``, their types checked."""
+    if not isinstance(result, tuple) or len(result) != 4:
+        raise CheckFailed(f"kmeans must return a tuple (labels, centers, inertia, n_iter), got {type(result).__name__}")
+    labels, centers, inertia, n_iter = result
+    check_array(labels, "labels", shape=(n,), dtype="int64")
+    check_array(centers, "centers", shape=(k, d))
+    check_array(inertia, "inertia", shape=(None,))
+    if isinstance(n_iter, bool) or not isinstance(n_iter, int | np.integer):
+        raise CheckFailed(f"n_iter must be an int, got {type(n_iter).__name__}")
+    if not 1 <= n_iter or len(inertia) != n_iter:
+        raise CheckFailed(f"inertia must hold one value per iteration (n_iter = {n_iter}), got {len(inertia)}")
+    return labels, centers, inertia, int(n_iter)
+
+
+def _nearest(points, centers):
+    """Each point's nearest centre by the contract's squared distance, ties to the lowest index."""
+    s = sum((points[:, j, None] - centers[None, :, j]) ** 2 for j in range(points.shape[1]))
+    return np.argmin(s, axis=1), s
+
+
+def _check_labels(labels, expected, what=""):
+    if not np.array_equal(labels, expected):
+        first = int(np.argmax(labels != expected))
+        raise CheckFailed(
+            f"labels are wrong{what}: point {first} has label {labels[first]}, expected {expected[first]}",
+            rule="labels are wrong",
+        )
+
+
+# --- kmeans ------------------------------------------------------------------------
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kmeans_returns_labels_centres_inertia_and_iterations(impl):
+    points = _blobs()
+    result = impl.kmeans(points, _first_points(points, 4, 1))
+    _unpack(result, len(points), 4, 3)
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(3)
+def test_kmeans_on_a_line_worked_by_hand(impl):
+    # x = 0, 1, 2, 10, 11, 12 from centres 0 and 1. Iteration 1: only x = 0 is nearer 0; inertia
+    # 0 + 0 + 1 + 81 + 100 + 121 = 303; centres 0 and 36 / 5 = 7.2. Iteration 2: 0, 1, 2 | 10, 11, 12;
+    # inertia 0 + 1 + 4 + 2.8^2 + 3.8^2 + 4.8^2 = 50.32; centres 1 and 11. Iteration 3: no label
+    # changes (inertia 4): stop, n_iter = 3.
+    points = np.array([[0.0], [1.0], [2.0], [10.0], [11.0], [12.0]])
+    labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, np.array([[0.0], [1.0]])), 6, 2, 1)
+    _check_labels(labels, np.array([0, 0, 0, 1, 1, 1]))
+    check_close(centers, [[1.0], [11.0]], "centers")
+    assert n_iter == 3, f"n_iter: expected 3 (the third assignment changes no label), got {n_iter}"
+    check_close(
+        inertia,
+        [303.0, 50.32, 4.0],
+        "inertia",
+        rtol=1e-12,
+        hint="inertia[t] is recorded at the "
+        "assignment of iteration t + 1, with the centres it assigned to (before their update)",
+    )
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(3)
+def test_kmeans_matches_scikit_learn_from_the_same_centres(impl):
+    for seed, (k, columns, max_iter) in enumerate([(3, 3, 300), (5, 2, 300), (8, 3, 300), (4, 5, 300), (6, 3, 4)]):
+        points = _blobs(800, centres=5, columns=columns, seed=seed)
+        start = _first_points(points, k, seed + 10)
+        expected = KMeans(k, init=start, n_init=1, max_iter=max_iter, tol=0, algorithm="lloyd").fit(points)
+        labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start, max_iter), len(points), k, columns)
+        _check_labels(labels, expected.labels_, f" (K = {k}, D = {columns})")
+        check_close(centers, expected.cluster_centers_, "centers", rtol=CENTRES_RTOL, atol=CENTRES_ATOL)
+        assert n_iter == expected.n_iter_, f"n_iter: expected {expected.n_iter_}, got {n_iter} (K = {k})"
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(2)
+def test_kmeans_truncated_runs_are_the_first_iterations(impl):
+    # max_iter = t: the first t iterations' inertia, then the centres updated once more and the
+    # labels assigned to them.
+    points = _blobs(500, centres=6, columns=2, seed=7)
+    start = _first_points(points, 6, 3)
+    full = _unpack(impl.kmeans(points, start), len(points), 6, 2)
+    assert full[3] > 3, f"this cloud takes more than 3 iterations, got n_iter = {full[3]}"
+    centers = start.copy()
+    for t in (1, 2, 3):
+        labels, _ = _nearest(points, centers)
+        centers = np.array([points[labels == c].mean(axis=0) for c in range(6)])  # no cluster empties here
+        expected_labels, _ = _nearest(points, centers)
+        got = _unpack(impl.kmeans(points, start, max_iter=t), len(points), 6, 2)
+        assert got[3] == t, f"max_iter = {t}: n_iter must be {t}, got {got[3]}"
+        check_close(got[2], full[2][:t], f"inertia with max_iter = {t}", rtol=1e-12)
+        check_close(
+            got[1],
+            centers,
+            f"centers after max_iter = {t}",
+            rtol=CENTRES_RTOL,
+            atol=CENTRES_ATOL,
+            hint="after the last iteration's update, the centres are returned as they are",
+        )
+        _check_labels(got[0], expected_labels, f" with max_iter = {t} (the assignment to the returned centres)")
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(2)
+def test_kmeans_an_empty_cluster_keeps_its_centre(impl):
+    rng = np.random.default_rng(5)
+    points = rng.uniform(0.0, 1.0, size=(60, 2))
+    start = np.array([[0.25, 0.5], [0.75, 0.5], [50.0, -50.0]])
+    labels, centers, _, _ = _unpack(impl.kmeans(points, start), 60, 3, 2)
+    assert not np.any(labels == 2), "no point is nearer the far centre than the other two"
+    check_close(
+        centers[2],
+        [50.0, -50.0],
+        "centers[2] (a cluster with no point)",
+        rtol=0,
+        atol=0,
+        hint="an empty cluster keeps its centre (no mean of nothing: NaN; no relocation)",
+    )
+    # Equal initial centres at the exact mean of a symmetric grid: ties send every point to the
+    # first, whose mean is that same centre; the second stays empty at it, and nothing changes.
+    grid = np.array([[x, y] for x in np.linspace(0.0, 1.0, 5) for y in np.linspace(0.0, 1.0, 5)])
+    labels, centers, _, n_iter = _unpack(impl.kmeans(grid, np.array([[0.5, 0.5], [0.5, 0.5]])), 25, 2, 2)
+    _check_labels(labels, np.zeros(25, dtype=np.int64), " (equal centres: ties go to the lowest index)")
+    check_close(centers, [[0.5, 0.5], [0.5, 0.5]], "centers", rtol=0, atol=0, hint="an empty cluster keeps its centre")
+    assert n_iter == 2, f"n_iter: expected 2 (the second assignment changes no label), got {n_iter}"
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(2)
+def test_kmeans_ties_go_to_the_lowest_centre(impl):
+    # On a grid every distance is exact. x = 2 is 1 from both centres 1 and 3 (centre 0 wins): then
+    # the centres are 1 (of 0, 1, 2) and 4 (of 4); nothing changes after. Ties to the highest index
+    # would give 0.5 (of 0, 1) and 3 (of 2, 4) instead.
+    points = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [4.0, 0.0]])
+    labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, np.array([[1.0, 0.0], [3.0, 0.0]])), 4, 2, 2)
+    _check_labels(labels, np.array([0, 0, 0, 1]), " (a point equidistant from two centres goes to the lower index)")
+    check_close(centers, [[1.0, 0.0], [4.0, 0.0]], "centers")
+    check_close(inertia, [3.0, 2.0], "inertia", rtol=1e-12)
+    assert n_iter == 2, f"n_iter: expected 2, got {n_iter}"
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(2)
+def test_kmeans_the_final_state_is_a_fixed_point(impl):
+    # Whatever the cloud: the labels are the nearest centres, every centre with points is their
+    # mean, the inertia never increases, and its last value is the returned state's.
+    rng = np.random.default_rng(11)
+    points = np.vstack([rng.normal(c, 0.6, size=(150, 3)) for c in ([0, 0, 0], [4, 0, 1], [0, 5, -2])])
+    points = points + [612.0, -340.0, 25.0]  # away from the origin
+    start = points[[0, 1, 2, 3, 4]].copy()  # five centres from one blob
+    labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start), len(points), 5, 3)
+    assert n_iter < 300, "this cloud converges well before 300 iterations"
+    nearest, s = _nearest(points, centers)
+    _check_labels(labels, nearest, " (each point's nearest returned centre)")
+    for c in np.unique(labels):
+        check_close(
+            centers[c],
+            points[labels == c].mean(axis=0),
+            f"centers[{c}] (the mean of its points)",
+            rtol=CENTRES_RTOL,
+            atol=1e-9,
+        )
+    assert np.all(np.diff(inertia) <= 1e-9 * inertia[0]), f"inertia must never increase, got {as_list(inertia, n_iter)}"
+    check_close(
+        inertia[-1],
+        s[np.arange(len(points)), labels].sum(),
+        "inertia[-1]",
+        rtol=1e-10,
+        hint="the sum of SQUARED distances of the points to their centres",
+    )
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(1)
+def test_kmeans_every_column_is_a_coordinate(impl):
+    # Two groups told apart by the fifth column alone: counting three columns would mix them.
+    rng = np.random.default_rng(2)
+    points = rng.normal(0.0, 0.1, size=(40, 5))
+    points[20:, 4] += 10.0
+    labels, centers, _, _ = _unpack(impl.kmeans(points, points[[0, 20]].copy()), 40, 2, 5)
+    _check_labels(labels, np.repeat([0, 1], 20), " (every column counts in the distance)")
+    check_close(
+        centers, [points[:20].mean(axis=0), points[20:].mean(axis=0)], "centers", rtol=CENTRES_RTOL, atol=CENTRES_ATOL
+    )
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kmeans_converts_float32_and_modifies_nothing(impl):
+    points = _blobs(300, centres=3, columns=3, seed=4).astype(np.float32)
+    start = _first_points(points, 3, 0)
+    labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start), 300, 3, 3)
+    check_unmodified(impl, "kmeans")
+    expected = _unpack(impl.kmeans(points.astype(np.float64), start.astype(np.float64)), 300, 3, 3)
+    _check_labels(labels, expected[0], " (float32 points are converted to float64 first)")
+    check_close(centers, expected[1], "centers", rtol=CENTRES_RTOL, atol=CENTRES_ATOL)
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kmeans_rejects_bad_arguments(impl):
+    points = _blobs(50, centres=2, columns=3, seed=1)
+    start = points[:2].copy()
+    nan = points.copy()
+    nan[3, 1] = np.nan
+    cases = [
+        ({"points": points[:, 0]}, "points"),
+        ({"points": nan}, "points"),
+        ({"points": np.empty((0, 3))}, "points"),
+        ({"init_centers": start[:, :2]}, "init_centers"),
+        ({"init_centers": np.empty((0, 3))}, "init_centers"),
+        ({"init_centers": np.vstack([points, points[:1]])}, "init_centers"),
+        ({"init_centers": np.full((2, 3), np.inf)}, "init_centers"),
+        ({"max_iter": 0}, "max_iter"),
+        ({"max_iter": 2.5}, "max_iter"),
+    ]
+    for change, name in cases:
+        arguments = {"points": points, "init_centers": start, "max_iter": 300, **change}
+        with raises(ValueError, naming=name):
+            impl.kmeans(**arguments)
+
+
+# --- kmeans_plusplus -----------------------------------------------------------------
+
+
+def d2_seeding(points, n_clusters, rng):
+    """The contract's draws, written from its docstring: the first index ``rng.integers(N)``, then
+    each next the smallest i with ``cumsum(w)[i] > u * cumsum(w)[-1]``, ``u = rng.random()``."""
+    rng = np.random.default_rng(rng)
+    chosen = [int(rng.integers(len(points)))]
+    w = ((points - points[chosen[0]]) ** 2).sum(axis=1)
+    while len(chosen) < n_clusters:
+        cumulative = np.cumsum(w)
+        u = rng.random()
+        chosen.append(int(np.flatnonzero(cumulative > u * cumulative[-1])[0]))
+        w = np.minimum(w, ((points - points[chosen[-1]]) ** 2).sum(axis=1))
+    return np.array(chosen)
+
+
+def _check_draws(result, expected, what):
+    check_array(result, "indices", shape=(len(expected),), dtype="int64")
+    if not np.array_equal(result, expected):
+        first = int(np.argmax(result != expected))
+        raise CheckFailed(
+            f"draw {first} is index {result[first]}, expected {expected[first]} ({what}): the first index is "
+            "rng.integers(N), each next one the D^2 draw of the docstring, with exactly one rng.random() each",
+            rule="the draws are wrong",
+        )
+
+
+@pytest.mark.grades("kmeans_plusplus")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kmeans_plusplus_returns_distinct_int64_indices(impl):
+    points = _blobs(400, centres=5, columns=3, seed=3)
+    result = impl.kmeans_plusplus(points, 8, rng=0)
+    check_array(result, "indices", shape=(8,), dtype="int64")
+    assert len(set(result.tolist())) == 8, f"the indices must be distinct, got {result.tolist()}"
+    assert result[0] == np.random.default_rng(0).integers(len(points)), (
+        f"the first index is rng.integers(N) = {np.random.default_rng(0).integers(len(points))}, got {result[0]}"
+    )
+
+
+@pytest.mark.grades("kmeans_plusplus")
+@pytest.mark.points(3)
+def test_kmeans_plusplus_draws_as_the_contract_says(impl):
+    for seed, (columns, k) in enumerate([(3, 5), (2, 10), (1, 4), (4, 6)]):
+        points = _blobs(300, centres=4, columns=columns, seed=seed) + 100.0
+        _check_draws(
+            impl.kmeans_plusplus(points, k, rng=seed + 40),
+            d2_seeding(points, k, seed + 40),
+            f"D = {columns}, rng = {seed + 40}",
+        )
+
+
+@pytest.mark.grades("kmeans_plusplus")
+@pytest.mark.points(1)
+def test_kmeans_plusplus_takes_a_generator_and_its_stream(impl):
+    points = _blobs(200, centres=3, columns=3, seed=9)
+    expected = d2_seeding(points, 6, np.random.default_rng(123))
+    _check_draws(impl.kmeans_plusplus(points, 6, rng=np.random.default_rng(123)), expected, "a Generator")
+    _check_draws(impl.kmeans_plusplus(points, 6, rng=123), expected, "the same seed as an int")
+
+
+@pytest.mark.grades("kmeans_plusplus")
+@pytest.mark.points(2)
+def test_kmeans_plusplus_never_draws_a_duplicate_of_a_chosen_point(impl):
+    # Five distinct points, each repeated: every draw must be a new position, up to all five.
+    base = np.array([[0.0, 0, 0], [1, 0, 0], [0, 2, 0], [0, 0, 3], [5, 5, 5]])
+    points = np.repeat(base, [7, 3, 5, 2, 4], axis=0)
+    for seed in range(6):
+        result = impl.kmeans_plusplus(points, 5, rng=seed)
+        check_array(result, "indices", shape=(5,), dtype="int64")
+        positions = {tuple(p) for p in points[as_list(result, 5)]}
+        assert len(positions) == 5, (
+            f"rng = {seed}: indices {result.tolist()} repeat a position: a point at distance 0 from a chosen "
+            "one has weight 0 and is never drawn (the first i with cumsum[i] > u * cumsum[-1], strictly)"
+        )
+        _check_draws(result, d2_seeding(points, 5, seed), f"rng = {seed}")
+
+
+@pytest.mark.grades("kmeans_plusplus")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_kmeans_plusplus_rejects_bad_arguments(impl):
+    points = np.repeat(np.eye(3), 4, axis=0)  # 12 points, 3 distinct
+    nan = points.copy()
+    nan[0, 0] = np.nan
+    cases = [
+        ({"n_clusters": 0}, "n_clusters"),
+        ({"n_clusters": 4}, "n_clusters"),  # more than the distinct points
+        ({"n_clusters": 2.0}, "n_clusters"),
+        ({"points": nan}, "points"),
+        ({"points": np.empty((0, 3))}, "points"),
+        ({"rng": "seed"}, "rng"),
+    ]
+    for change, name in cases:
+        arguments = {"points": points, "n_clusters": 2, "rng": 0, **change}
+        with raises(ValueError, naming=name):
+            impl.kmeans_plusplus(**arguments)
