@@ -1,10 +1,17 @@
-"""Reference: k-means (Lloyd's algorithm) and the k-means++ seeding."""
+"""Reference: k-means (Lloyd's algorithm) and the k-means++ seeding. The docstrings are the stubs'
+(``pcl_course/cluster.py``: the contract)."""
 
 import numpy as np
 
+from pcl_course import cluster as _contract
 from pcl_course.validation import as_array, as_points, check_integer, check_rng
 
 __all__ = ["kmeans", "kmeans_plusplus"]
+
+
+def _documented(function):
+    function.__doc__ = getattr(_contract, function.__name__).__doc__
+    return function
 
 
 def _squared_distances(points, centers):
@@ -35,6 +42,7 @@ def _means(points, labels, centers):
     return moved
 
 
+@_documented
 def kmeans(points, init_centers, max_iter=300):
     points = as_points(points, min_columns=1, allow_empty=False)
     centers = as_array(init_centers, "init_centers", ndim=2)
@@ -58,6 +66,7 @@ def kmeans(points, init_centers, max_iter=300):
     return labels.astype(np.int64), centers, np.array(inertia), len(inertia)
 
 
+@_documented
 def kmeans_plusplus(points, n_clusters, rng=None):
     points = as_points(points, min_columns=1, allow_empty=False)
     distinct = len(np.unique(points, axis=0))

@@ -8,6 +8,8 @@ tests' own few-line implementations of the contract's rules (the k-means++
 draws, the truncated runs), written from the contract, not from the reference.
 """
 
+import copy
+
 import numpy as np
 import pytest
 from sklearn.cluster import KMeans
@@ -228,6 +230,7 @@ def test_kmeans_converts_float32_and_modifies_nothing(impl):
     labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start), 300, 3, 3)
     check_unmodified(impl, "kmeans")
     expected = _unpack(impl.kmeans(points.astype(np.float64), start.astype(np.float64)), 300, 3, 3)
+    check_unmodified(impl, "kmeans")  # float64 centres: no conversion copies them
     _check_labels(labels, expected[0], " (float32 points are converted to float64 first)")
     check_close(centers, expected[1], "centers", rtol=CENTRES_RTOL, atol=CENTRES_ATOL)
 
@@ -334,6 +337,32 @@ def test_kmeans_plusplus_never_draws_a_duplicate_of_a_chosen_point(impl):
             "one has weight 0 and is never drawn (the first i with cumsum[i] > u * cumsum[-1], strictly)"
         )
         _check_draws(result, d2_seeding(points, 5, seed), f"rng = {seed}")
+
+
+def _generator_drawing_zero():
+    """A PCG64 Generator whose ``integers(10)`` is 4 and whose next ``random()`` is exactly 0.0:
+    its state set two steps before one whose output is 0 (the 128-bit LCG run backwards)."""
+    multiplier, modulus = 0x2360ED051FC65DA44385DF649FCCF645, 1 << 128
+    inverse = pow(multiplier, -1, modulus)
+    generator = np.random.Generator(np.random.PCG64(0))
+    state = generator.bit_generator.state
+    increment = state["state"]["inc"]
+    zero = (12345 << 64) | 12345  # high and low halves equal: this step outputs 0
+    state["state"]["state"] = ((((zero - increment) * inverse) % modulus - increment) * inverse) % modulus
+    state["has_uint32"], state["uinteger"] = 0, 0
+    generator.bit_generator.state = state
+    return generator
+
+
+@pytest.mark.grades("kmeans_plusplus")
+@pytest.mark.points(1)
+def test_kmeans_plusplus_a_draw_of_zero_takes_the_first_point_of_positive_weight(impl):
+    # u = 0: the smallest i with cum[i] > 0 is the first point of positive weight; ">=" (or
+    # searchsorted's default side) would take point 0, a duplicate of the first chosen point 4.
+    points = np.arange(10.0)[:, None] ** 1.5
+    points[0] = points[4]
+    expected = d2_seeding(points, 3, copy.deepcopy(_generator_drawing_zero()))
+    _check_draws(impl.kmeans_plusplus(points, 3, rng=_generator_drawing_zero()), expected, "a draw u = 0.0")
 
 
 @pytest.mark.grades("kmeans_plusplus")

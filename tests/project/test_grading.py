@@ -178,7 +178,7 @@ def declared_mistake(path):
 
 # Of each lecture's mutants, the share named by their diagnosis. Lecture 1 keeps one mutant unnamed
 # (normal_space_sampling/uniform_sampling: a uniform draw cannot be told from a right one draw by draw).
-DIAGNOSIS_FLOOR = {"lecture1": 0.9, "lecture2": 1.0}
+DIAGNOSIS_FLOOR = {"lecture1": 0.9, "lecture2": 1.0, "lecture3": 0.9}
 
 
 # Modules whose submissions are graded several at a time: one wrong (or other correct) version of
@@ -186,7 +186,7 @@ DIAGNOSIS_FLOOR = {"lecture1": 0.9, "lecture2": 1.0}
 # module), one grading for them all. Sound where no test calls a second function but those
 # KEPT_APART (two tests below keep it so). Mistakes found in the module's source (a forbidden API,
 # a signature) stay alone: the generated module's source is not theirs.
-GRADED_TOGETHER = ("pca", "normals", "downsampling", "filters", "metrics", "nn")
+GRADED_TOGETHER = ("pca", "normals", "downsampling", "filters", "metrics", "nn", "cluster")
 READ_FROM_SOURCE = ("forbidden_api", "signature")
 # Functions whose tests call another graded function: never in one batch with it (a wrong kernel_pca
 # would make kernel_pca_transform's tests fail for a reason not its own).

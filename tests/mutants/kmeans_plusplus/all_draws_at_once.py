@@ -1,0 +1,31 @@
+"""Draws rng.random(n_clusters) after the first index and uses u[1:], one uniform per seed with the first
+unused: the stream is shifted by one draw."""
+
+import numpy as np
+
+from pcl_course.validation import check_rng
+from solutions.cluster import *  # noqa: F401,F403
+from solutions.cluster import kmeans_plusplus as _reference
+
+MISTAKE = "all_draws_at_once"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
+
+
+def _squared_to(x, c):
+    s = np.zeros(len(x))
+    for j in range(x.shape[1]):
+        s += (x[:, j] - c[j]) ** 2
+    return s
+
+
+def kmeans_plusplus(points, n_clusters, rng=None):
+    _reference(points, n_clusters, 0)  # validation only (not the caller's rng: it would consume it)
+    x = np.asarray(points, dtype=float)
+    rng = check_rng(rng)  # the contract's np.random.default_rng(rng), a bad rng refused
+    chosen = [int(rng.integers(len(x)))]
+    u = rng.random(n_clusters)
+    nearest = _squared_to(x, x[chosen[0]])
+    for k in range(1, n_clusters):
+        cum = np.cumsum(nearest)
+        chosen.append(int(np.searchsorted(cum, u[k] * cum[-1], side="right")))
+        nearest = np.minimum(nearest, _squared_to(x, x[chosen[-1]]))
+    return np.array(chosen, dtype=np.int64)
