@@ -8,7 +8,7 @@
 #   make grade SUBMISSION=dir    grade a student's clone
 #   make requirements   re-pin requirements/ (the lock and its two subsets)
 #   make bench    time the references against Open3D, scikit-learn and fpsample
-#   make gradescope   write the Gradescope autograder archive of ASSIGNMENT (lecture1, lecture2)
+#   make gradescope   write the Gradescope autograder archive of ASSIGNMENT (lecture1, lecture2, lecture3)
 SUBMISSION ?=
 RESULTS ?= results/results.json
 ASSIGNMENT ?= lecture1
@@ -106,7 +106,7 @@ grade: setup $(NUMBA_STAMP)
 	$(BIN)/python -m grading grade "$(SUBMISSION)" --results "$(RESULTS)"
 
 # The archive instructors upload to Gradescope as an assignment's autograder,
-# one per lecture (ASSIGNMENT=lecture1 or lecture2, grading.config.ASSIGNMENTS):
+# one per lecture (ASSIGNMENT=lecture1, lecture2 or lecture3, grading.config.ASSIGNMENTS):
 # grader, stubs, public and hidden tests, setup.sh and run_autograder; no
 # solutions (it is scanned for them). README "Running a class".
 gradescope: setup
