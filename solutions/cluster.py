@@ -5,6 +5,7 @@ import numpy as np
 
 from pcl_course import cluster as _contract
 from pcl_course.validation import as_array, as_points, check_integer, check_rng
+from solutions._fast.lloyd import assign, cluster_sums
 
 __all__ = ["kmeans", "kmeans_plusplus"]
 
@@ -25,17 +26,13 @@ def _squared_distances(points, centers):
 
 def _assign(points, centers):
     """Each point's nearest centre (ties to the lowest index) and the sum of the squared distances."""
-    s = _squared_distances(points, centers)
-    labels = np.argmin(s, axis=1)  # the first minimum: the lowest index
-    return labels, float(s[np.arange(len(points)), labels].sum())
+    labels, distances = assign(points, centers)
+    return labels, float(distances.sum())
 
 
 def _means(points, labels, centers):
     """Each centre moved to the mean of its points (summed in index order); an empty one kept."""
-    counts = np.bincount(labels, minlength=len(centers))
-    sums = np.column_stack(
-        [np.bincount(labels, weights=points[:, j], minlength=len(centers)) for j in range(points.shape[1])]
-    )
+    sums, counts = cluster_sums(points, labels, len(centers))
     filled = counts > 0
     moved = centers.copy()
     moved[filled] = sums[filled] / counts[filled, None]
@@ -44,14 +41,14 @@ def _means(points, labels, centers):
 
 @_documented
 def kmeans(points, init_centers, max_iter=300):
-    points = as_points(points, min_columns=1, allow_empty=False)
+    points = np.ascontiguousarray(as_points(points, min_columns=1, allow_empty=False))
     centers = as_array(init_centers, "init_centers", ndim=2)
     if centers.shape[1] != points.shape[1]:
         raise ValueError(f"init_centers must have {points.shape[1]} columns (the width of points), got {centers.shape}")
     if not 1 <= len(centers) <= len(points):
         raise ValueError(f"init_centers must hold 1 to {len(points)} centres (N), got {len(centers)}")
     max_iter = check_integer(max_iter, "max_iter", low=1)
-    centers = centers.copy()
+    centers = np.ascontiguousarray(centers, dtype=np.float64).copy()
     inertia = []
     previous = None
     for t in range(1, max_iter + 1):
@@ -63,7 +60,7 @@ def kmeans(points, init_centers, max_iter=300):
         previous = labels
         if t == max_iter:
             labels, _ = _assign(points, centers)
-    return labels.astype(np.int64), centers, np.array(inertia), len(inertia)
+    return labels, centers, np.array(inertia), len(inertia)
 
 
 @_documented

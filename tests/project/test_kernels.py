@@ -39,6 +39,7 @@ import solutions._fast
 from grading import REPO_ROOT
 from grading.instructors import tree_searches, trees
 from solutions import downsampling, filters, nn, normals
+from solutions._fast import lloyd
 from solutions._fast.grid import grid_radius_count
 from solutions._fast.knn import LEAF_SIZE, leaf_knn
 from solutions._fast.sorting import search_left, sort_pairs, sort_range
@@ -241,6 +242,27 @@ def _sort_cases():
     yield "organ pipe", np.r_[np.arange(1500.0), np.arange(1500.0)[::-1]]
 
 
+# --- lecture 3: Lloyd's assignment and sums ----------------------------------------------------
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_lloyd_under_stress(name):
+    points = CLOUDS[name]
+    rng = np.random.default_rng(len(points))
+    for k in sorted({1, min(3, len(points)), len(points)}):
+        # Centres on points (exact ties where points repeat) and a copy of the first (a tie for all).
+        centers = np.vstack([points[rng.choice(len(points), k, replace=False)], points[:1]])
+        labels, distances = lloyd.assign(points, centers)
+        s = sum((points[:, j, None] - centers[None, :, j]) ** 2 for j in range(points.shape[1]))
+        np.testing.assert_array_equal(labels, np.argmin(s, axis=1), err_msg=f"k={k}")
+        np.testing.assert_array_equal(distances, s.min(axis=1))
+        sums, counts = lloyd.cluster_sums(points, labels, len(centers))
+        np.testing.assert_array_equal(counts, np.bincount(labels, minlength=len(centers)))
+        expected = np.zeros_like(sums)
+        np.add.at(expected, labels, points)  # in index order, as the kernel
+        np.testing.assert_array_equal(sums, expected)
+
+
 @pytest.mark.parametrize("name, keys", list(_sort_cases()), ids=lambda v: v if isinstance(v, str) else "")
 def test_the_kernels_sort_is_numpys(name, keys):
     values = keys.copy()
@@ -327,6 +349,7 @@ def test_every_kernel_runs_here():
             test_voxels_and_sampling_under_stress,
             test_trees_under_stress,
             test_bst_under_stress,
+            test_lloyd_under_stress,
         ):
             test(name)
     dispatchers = _dispatchers()
