@@ -43,6 +43,9 @@ __all__ = [
     "kdtree_partitions",
     "octant_tests",
     "root_squares",
+    "kmeans_trajectories",
+    "ratio_distributions",
+    "cluster_panels",
 ]
 
 
@@ -1182,4 +1185,97 @@ def root_squares(points, panels, figsize=(10, 4.6)):
         ax.set(title=title, aspect="equal", xlim=(lower[0] - pad, upper[0] + pad),
                ylim=(lower[1] - pad, upper[1] + pad))  # fmt: skip
         ax.legend(loc="lower right")
+    plt.show()
+
+
+def kmeans_trajectories(points, labels, centers, inertia, figsize=(11, 4.4)):
+    """Lloyd's iterations on a 2-D cloud: the centres' paths over the final clusters, and the inertia.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+    labels : array_like of shape (N,)
+        The final labels, ``0 .. K - 1``; the points are coloured by them.
+    centers : array_like of shape (T + 1, K, 2)
+        The centres before the first iteration (``centers[0]``, the initial ones) and after each of
+        the ``T`` iterations.
+    inertia : array_like of shape (T,)
+        The inertia recorded at each iteration's assignment.
+    """
+    import matplotlib.pyplot as plt
+
+    points, labels, centers = np.asarray(points, dtype=float), np.asarray(labels), np.asarray(centers, dtype=float)
+    fig, (left, right) = plt.subplots(1, 2, figsize=figsize, gridspec_kw={"width_ratios": [1.15, 1]})
+    for k in range(centers.shape[1]):
+        colour = f"C{k % 10}"
+        left.scatter(*points[labels == k].T, s=5, c=colour, alpha=0.35, lw=0)
+        left.plot(*centers[:, k].T, c="k", lw=1.2, marker="o", ms=3)
+        left.plot(*centers[0, k], marker="X", ms=10, c=colour, mec="k", label="initial centres" if k == 0 else None)
+        left.plot(*centers[-1, k], marker="*", ms=15, c=colour, mec="k", label="final centres" if k == 0 else None)
+    left.set(aspect="equal", title="centres after each iteration", xlabel="x", ylabel="y")
+    left.legend(loc="best", fontsize=8)
+    iterations = np.arange(1, len(inertia) + 1)
+    right.plot(iterations, inertia, marker="o")
+    right.set(yscale="log", xlabel="iteration t", ylabel="inertia (sum of squared distances)",
+              title="inertia at each assignment")  # fmt: skip
+    right.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    plt.show()
+
+
+def ratio_distributions(panels, xlabel, figsize=(11, 4)):
+    """Empirical distribution functions of cost ratios (one panel per stage, one curve per method).
+
+    Parameters
+    ----------
+    panels : dict of str to dict of str to array_like
+        Panel title -> method label -> the ratios of its runs (at least 1).
+    xlabel : str
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(panels), figsize=figsize, squeeze=False, sharey=True)
+    for ax, (title, curves_) in zip(axes[0], panels.items()):
+        for j, (label, ratios) in enumerate(curves_.items()):
+            ratios = np.sort(np.asarray(ratios, dtype=float))
+            share = np.arange(1, len(ratios) + 1) / len(ratios)
+            ax.step(np.concatenate([[ratios[0]], ratios]), np.concatenate([[0.0], share]), where="post",
+                    c=f"C{j}", lw=1.8, label=f"{label} (median {np.median(ratios):.2f})")  # fmt: skip
+        ax.set(xscale="log", xlabel=xlabel, title=title, ylim=(0, 1.02))
+        low, high = ax.get_xlim()
+        ticks = [v for v in (1, 1.5, 2, 3, 5, 10, 20, 30, 50, 100, 200) if low <= v <= high]
+        ax.set_xticks(ticks, [f"{v:g}" for v in ticks])  # plain numbers at a few places, no crowded 2x10^0
+        ax.set_xticks([], minor=True)
+        ax.set_xlim(low, high)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(loc="lower right", fontsize=8)
+    axes[0][0].set_ylabel("share of the runs with a ratio at most x")
+    fig.tight_layout()
+    plt.show()
+
+
+def cluster_panels(panels, columns=None, figsize=(11, 3.4)):
+    """2-D clouds coloured by cluster, one panel each, with the centres as black crosses.
+
+    Parameters
+    ----------
+    panels : dict of str to (array_like of shape (N, 2), array_like of shape (N,), array_like of shape (K, 2) or None)
+        Title -> the points, their labels and the centres (``None``: none drawn).
+    columns : int, optional
+        Panels per row; default, all in one row.
+    """
+    import matplotlib.pyplot as plt
+
+    columns = len(panels) if columns is None else columns
+    rows = -(-len(panels) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=figsize, squeeze=False)
+    for ax, (title, (points, labels, centers)) in zip(axes.flat, panels.items()):
+        points, labels = np.asarray(points, dtype=float), np.asarray(labels)
+        ax.scatter(points[:, 0], points[:, 1], s=4, c=[f"C{k % 10}" for k in labels], lw=0)
+        if centers is not None:
+            ax.scatter(*np.asarray(centers, dtype=float).T, marker="X", s=90, c="k", ec="w", lw=1)
+        ax.set(title=title, aspect="equal", xticks=[], yticks=[])
+    for ax in axes.flat[len(panels) :]:
+        ax.axis("off")
+    fig.tight_layout()
     plt.show()
