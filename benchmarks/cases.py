@@ -380,6 +380,46 @@ def _octree_radius_case(n):
     )  # fmt: skip
 
 
+def _kmeans_case(dataset, n, k=8, iterations=30):
+    """``iterations`` of Lloyd from the same ``k`` points of the cloud, in every implementation (no
+    tolerance: each stops only when no label changes, as the contract does, or after them all)."""
+
+    def make():
+        import warnings
+
+        from scipy.cluster.vq import kmeans2
+        from sklearn.cluster import KMeans
+
+        from solutions.cluster import kmeans
+
+        xyz = cloud(dataset, n)
+        start = xyz[np.random.default_rng(0).choice(n, k, replace=False)].copy()
+
+        def scipy_kmeans2():
+            with warnings.catch_warnings():  # an empty cluster warns (and keeps its centre, as ours)
+                warnings.simplefilter("ignore")
+                return kmeans2(xyz, start, iter=iterations, minit="matrix", missing="warn")
+
+        def scikit_learn(algorithm):
+            fit = KMeans(k, init=start, n_init=1, max_iter=iterations, tol=0, algorithm=algorithm)
+            return lambda: fit.fit(xyz)
+
+        return {
+            "reference": lambda: kmeans(xyz, start, iterations),
+            "scikit-learn-lloyd": scikit_learn("lloyd"),
+            "scikit-learn-elkan": scikit_learn("elkan"),
+            "scipy-kmeans2": scipy_kmeans2,
+        }
+
+    target = (FASTEST_PEER, 1.0) if n >= 100_000 else None
+    return Case("kmeans", f"k{k}", dataset, n, make, {"k": k, "iterations": iterations}, target)
+
+
+def cluster_cases(sizes=SIZES, datasets=DATASETS):
+    """Lecture 3's cases: k-means on the cube and the scan."""
+    return [_kmeans_case(dataset, n) for dataset in datasets if dataset in ("cube", "scan") for n in sizes]
+
+
 NN_CASES = ("kdtree_build", "kdtree_knn", "kdtree_radius", "octree_radius")
 
 
@@ -413,4 +453,4 @@ def all_cases(sizes=SIZES, kernel_sizes=KERNEL_SIZES, datasets=DATASETS):
         cases += [_kernel_pca_case(dataset, n) for n in kernel_sizes]
     cases += [_kernel_matrix_case(n) for n in kernel_sizes]
     cases += [_pca_case(n) for n in sizes] + [_chamfer_case(n) for n in sizes]
-    return cases + nn_cases(sizes, datasets)
+    return cases + nn_cases(sizes, datasets) + cluster_cases(sizes, datasets)
