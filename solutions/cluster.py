@@ -24,12 +24,6 @@ def _squared_distances(points, centers):
     return s
 
 
-def _assign(points, centers):
-    """Each point's nearest centre (ties to the lowest index) and the sum of the squared distances."""
-    labels, distances = assign(points, centers)
-    return labels, float(distances.sum())
-
-
 def _means(points, labels, centers):
     """Each centre moved to the mean of its points (summed in index order); an empty one kept."""
     sums, counts = cluster_sums(points, labels, len(centers))
@@ -49,17 +43,19 @@ def kmeans(points, init_centers, max_iter=300):
         raise ValueError(f"init_centers must hold 1 to {len(points)} centres (N), got {len(centers)}")
     max_iter = check_integer(max_iter, "max_iter", low=1)
     centers = np.ascontiguousarray(centers, dtype=np.float64).copy()
+    columns = np.ascontiguousarray(points.T)  # the assignment reads a column at a time
+    labels, previous = np.empty(len(points), dtype=np.int64), np.empty(len(points), dtype=np.int64)
+    distances = np.empty(len(points))
     inertia = []
-    previous = None
     for t in range(1, max_iter + 1):
-        labels, total = _assign(points, centers)
-        inertia.append(total)
-        if previous is not None and np.array_equal(labels, previous):
+        assign(columns, centers, labels, distances)
+        inertia.append(float(distances.sum()))
+        if t > 1 and np.array_equal(labels, previous):
             break
         centers = _means(points, labels, centers)
-        previous = labels
+        labels, previous = previous, labels
         if t == max_iter:
-            labels, _ = _assign(points, centers)
+            assign(columns, centers, labels, distances)
     return labels, centers, np.array(inertia), len(inertia)
 
 

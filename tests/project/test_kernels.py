@@ -252,11 +252,12 @@ def test_lloyd_under_stress(name):
     for k in sorted({1, min(3, len(points)), len(points)}):
         # Centres on points (exact ties where points repeat) and a copy of the first (a tie for all).
         centers = np.vstack([points[rng.choice(len(points), k, replace=False)], points[:1]])
-        labels, distances = lloyd.assign(points, centers)
+        columns = np.ascontiguousarray(points.T)
+        labels, distances = lloyd.assign(columns, centers)
         s = sum((points[:, j, None] - centers[None, :, j]) ** 2 for j in range(points.shape[1]))
         np.testing.assert_array_equal(labels, np.argmin(s, axis=1), err_msg=f"k={k}")
         np.testing.assert_array_equal(distances, s.min(axis=1))
-        sums, counts = lloyd.cluster_sums(points, labels, len(centers))
+        sums, counts = lloyd.cluster_sums(np.ascontiguousarray(points), labels, len(centers))
         np.testing.assert_array_equal(counts, np.bincount(labels, minlength=len(centers)))
         expected = np.zeros_like(sums)
         np.add.at(expected, labels, points)  # in index order, as the kernel
