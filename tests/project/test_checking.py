@@ -7,7 +7,7 @@ from _helpers import SUBPROCESS_BACKSTOP
 from nbclient import NotebookClient
 
 import pcl_course
-from grading import REPO_ROOT
+from grading import ASSIGNMENTS, REPO_ROOT
 
 
 def test_check_in_a_notebook_cell_shows_the_marks_and_feedback_as_markdown(tmp_path):
@@ -35,7 +35,7 @@ def test_check_in_a_terminal_is_the_graders_table_and_selects_a_module_or_a_lect
     "name, assignment, message",
     [
         ("pcaa", None, "name must be a graded function"),
-        ("pca", "lecture3", "assignment must be one of lecture1, lecture2"),
+        ("pca", "lecture9", "assignment must be one of " + ", ".join(ASSIGNMENTS)),
         ("pca", "lecture2", "name 'pca' is not graded in assignment 'lecture2'"),
     ],
 )
