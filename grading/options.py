@@ -72,6 +72,12 @@ SHARED = (
         {"action": "store_true"},
         hidden=True,
     ),
+    Option(
+        "--no-diagnosis",
+        "skip the diagnosis (the project's checks of marks alone: degenerate answers)",
+        {"action": "store_true"},
+        hidden=True,
+    ),
 )
 
 # Set by the runner only.

@@ -448,7 +448,7 @@ def pytest_unconfigure(config):
 
 
 def pytest_sessionfinish(session, exitstatus):
-    if not hasattr(session.config, "workerinput"):
+    if not hasattr(session.config, "workerinput") and not session.config.getoption("--no-diagnosis"):
         _diagnose(session.config)
     _write_results(session.config)
 
