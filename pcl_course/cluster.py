@@ -78,7 +78,8 @@ def kmeans(points, init_centers, max_iter=300):
         The final centres.
     inertia : ndarray of float64, shape (n_iter,)
         The sum of squared distances recorded at each iteration's
-        assignment; it never increases.
+        assignment; it never increases (in exact arithmetic: the tests
+        allow for rounding).
     n_iter : int
         The number of iterations run, ``1 <= n_iter <= max_iter``.
 
@@ -102,8 +103,9 @@ def kmeans_plusplus(points, n_clusters, rng=None):
        duplicates), ``cum = np.cumsum(w)`` (in index order) and
        ``u = rng.random()``; the index is the smallest i with
        ``cum[i] > u * cum[-1]``. (A point is drawn with probability
-       proportional to ``w``; ``rng.choice(N, p=w / w.sum())`` draws the
-       same way.)
+       proportional to ``w``: ``rng.choice(N, p=w / w.sum())`` makes the
+       same single draw and, but for rounding where ``u * cum[-1]`` falls
+       on a boundary, returns the same index.)
 
     No other draw is made. Points at distance 0 from a chosen point are
     never drawn, so the indices are distinct and no two chosen points are
