@@ -45,7 +45,9 @@ __all__ = [
 
 
 def _documented(function):
-    function.__doc__ = getattr(_contract, function.__name__).__doc__
+    # The stub's text; none where this file is itself the module (a reference uploaded as a
+    # student's pcl_course/, the project's tests): the contract is then half imported.
+    function.__doc__ = getattr(_contract, function.__name__, function).__doc__
     return function
 
 

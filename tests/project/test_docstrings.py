@@ -62,3 +62,18 @@ def test_the_validation_helpers_examples_run():
 
     failures, tries = doctest.testmod(validation, optionflags=doctest.NORMALIZE_WHITESPACE)
     assert tries > 0 and failures == 0
+
+
+def test_the_reference_imports_as_a_students_package(tmp_path):
+    """The references copy the stubs' docstrings from ``pcl_course``: copied into a student's package
+    (the project's reference uploads), each module imports itself, half initialised, and must not
+    fail there (lecture 3's reference scored 0 on its Gradescope archive so)."""
+    import subprocess
+    import sys
+
+    from _helpers import reference_package
+
+    reference_package(tmp_path / "pcl_course")
+    script = "import importlib\n" + "".join(f"importlib.import_module('pcl_course.{m}')\n" for m in EXERCISE_MODULES)
+    completed = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True)
+    assert completed.returncode == 0, completed.stderr[-2000:]

@@ -331,3 +331,28 @@ def test_the_permission_probe_checks_the_platforms_folder(tmp_path, monkeypatch)
     protect(tmp_path)
     assert tmp_path.resolve() in protected_paths()  # and every grading process started from here
     assert str(tmp_path.resolve()) in os.environ[PROTECTED_PATHS_VARIABLE].split(os.pathsep)
+
+
+@needs_root
+def test_lecture_3s_archive_gives_the_reference_full_marks_as_a_dedicated_uid(tmp_path):
+    """Each lecture is its own Gradescope assignment. Lecture 3's module has rules of its own
+    (scipy.cluster), as nn.py has (scipy.spatial): in the uid mode it runs as its own set of rules'
+    uid, barred from its packages only; the reference (which copies the stubs' docstrings) imports
+    as a student's package."""
+    archive = tmp_path / "autograder-lecture3.zip"
+    completed = subprocess.run(
+        [sys.executable, "-m", "grading", "gradescope", str(archive), "--assignment", "lecture3"],
+        cwd=REPO_ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert completed.returncode == 0, completed.stderr
+    root = autograder_root(archive, tmp_path / "autograder")
+    reference_package(root / "submission" / "my-repo" / "pcl_course")
+    results, printed = run_autograder(root, namespaces=False)
+    assert {t["tags"][0] for t in results["tests"]} == set(ASSIGNMENTS["lecture3"])
+    assert results["score"] == sum(t["max_score"] for t in results["tests"]) > 0, [
+        t["output"] for t in results["tests"] if t["score"] < t["max_score"]
+    ][:2]
+    assert results["grading"].isolation.startswith("isolated: dedicated uid")
+    assert "Traceback" not in printed
