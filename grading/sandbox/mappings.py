@@ -23,7 +23,7 @@ What the reading cannot see: a library unmapped before the call returns
 (``dlclose``) or used in a child that exits first. The environment's
 forbidden packages are out of such a process's reach (masked under
 bubblewrap; barred by ACLs for the sandbox uids, a module's own for its
-second uid, :func:`grading.sandbox.walls.rules_uid`), so it would need a
+set of rules' uid, :func:`grading.sandbox.walls.rules_uid`), so it would need a
 library the submission carries as data in its source and writes out itself
 (staging refuses compiled files, not text): a deliberate forgery, which
 this module does not claim to stop.

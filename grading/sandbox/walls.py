@@ -178,7 +178,7 @@ def bar_forbidden_packages():
 
 
 def bar_sandbox_uids(paths, also_barred_from=None):
-    """Deny every sandbox uid (both uids of every slot, or the uids ``also_barred_from``)
+    """Deny every sandbox uid (every uid of every slot, or the uids ``also_barred_from``)
     all access to ``paths`` with a POSIX ACL (``setfacl``).
 
     Without namespaces nothing can hide a file from a process, but a named
