@@ -168,6 +168,11 @@ FORBIDDEN_IN_MODULE = {
     # forbidden everywhere already).
     "cluster": ("scipy.cluster", "hdbscan", "fast_hdbscan", "dbscan", "pyclustering", "kmeans1d", "faiss"),
 }
+# Why, in the words the grader's forbidden-API line uses: one per module of FORBIDDEN_IN_MODULE.
+MODULE_RULES_WHY = {
+    "nn": "this lecture is about writing the search: no library's neighbour search, nor pcl_course.neighbors",
+    "cluster": "this lecture is about writing the clustering algorithms: no library's k-means or clustering",
+}
 
 # -- the instructors' reports (grading/instructors/) -------------------------------
 # Gradescope's submission_metadata.yml is read with these caps, an alias counted as

@@ -6,7 +6,7 @@ wrong and, where it can, what to do.
 
 from pathlib import Path
 
-from grading.config import FORBIDDEN_IN_MODULE
+from grading.config import FORBIDDEN_IN_MODULE, MODULE_RULES_WHY
 
 
 class UsageError(Exception):
@@ -94,10 +94,7 @@ class ForbiddenAPI(Exception):
 
     def __init__(self, module, violations):
         shown = "; ".join(str(v) for v in violations[:3])
-        if module in FORBIDDEN_IN_MODULE:
-            why = "this lecture is about writing the search: no library's neighbour search, nor pcl_course.neighbors"
-        else:
-            why = VISUALISATION_ONLY
+        why = MODULE_RULES_WHY[module] if module in FORBIDDEN_IN_MODULE else VISUALISATION_ONLY
         super().__init__(f"forbidden API in {module}.py ({shown}): write your own code; {why}")
 
 

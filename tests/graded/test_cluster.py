@@ -43,7 +43,10 @@ def _unpack(result, n, k, d):
     if isinstance(n_iter, bool) or not isinstance(n_iter, int | np.integer):
         raise CheckFailed(f"n_iter must be an int, got {type(n_iter).__name__}")
     if not 1 <= n_iter or len(inertia) != n_iter:
-        raise CheckFailed(f"inertia must hold one value per iteration (n_iter = {n_iter}), got {len(inertia)}")
+        raise CheckFailed(
+            f"n_iter = {n_iter} but inertia holds {len(inertia)} values: n_iter counts the iterations, the last "
+            "one (which found no label changed) included, and each records one inertia"
+        )
     return labels, centers, inertia, int(n_iter)
 
 
@@ -51,6 +54,33 @@ def _nearest(points, centers):
     """Each point's nearest centre by the contract's squared distance, ties to the lowest index."""
     s = sum((points[:, j, None] - centers[None, :, j]) ** 2 for j in range(points.shape[1]))
     return np.argmin(s, axis=1), s
+
+
+def _lloyd(points, centers, max_iter=300):
+    """The contract's iterations, written here: labels, centres, inertia list, n_iter."""
+    centers = np.array(centers, dtype=float)
+    previous, inertia = None, []
+    for t in range(1, max_iter + 1):
+        labels, s = _nearest(points, centers)
+        inertia.append(float(s[np.arange(len(points)), labels].sum()))
+        if previous is not None and np.array_equal(labels, previous):
+            return labels, centers, inertia, t
+        for c in range(len(centers)):
+            if np.any(labels == c):
+                centers[c] = points[labels == c].mean(axis=0)
+        previous = labels
+    return _nearest(points, centers)[0], centers, inertia, max_iter
+
+
+def _check_run(impl, points, start, max_iter=300, what=""):
+    """``kmeans`` from ``start`` against :func:`_lloyd`: labels, centres, n_iter and inertia."""
+    expected = _lloyd(points, start, max_iter)
+    labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start, max_iter), *points.shape[:1], *start.shape)
+    _check_labels(labels, expected[0], what)
+    scale = float(np.abs(points).max())
+    check_close(centers, expected[1], f"centers{what}", rtol=CENTRES_RTOL, atol=CENTRES_ATOL * scale)
+    assert n_iter == expected[3], f"n_iter{what}: expected {expected[3]}, got {n_iter}"
+    check_close(inertia, expected[2], f"inertia{what}", rtol=1e-9, atol=1e-12 * scale**2)
 
 
 def _check_labels(labels, expected, what=""):
@@ -91,7 +121,7 @@ def test_kmeans_on_a_line_worked_by_hand(impl):
         [303.0, 50.32, 4.0],
         "inertia",
         rtol=1e-12,
-        hint="inertia[t] is recorded at the "
+        hint="inertia[t] is the SUM (not the mean) of the squared distances at the "
         "assignment of iteration t + 1, with the centres it assigned to (before their update)",
     )
 
@@ -144,7 +174,9 @@ def test_kmeans_an_empty_cluster_keeps_its_centre(impl):
     points = rng.uniform(0.0, 1.0, size=(60, 2))
     start = np.array([[0.25, 0.5], [0.75, 0.5], [50.0, -50.0]])
     labels, centers, _, _ = _unpack(impl.kmeans(points, start), 60, 3, 2)
-    assert not np.any(labels == 2), "no point is nearer the far centre than the other two"
+    assert not np.any(labels == 2), (
+        f"your labels put {int(np.sum(labels == 2))} points in cluster 2, whose centre is far from every point"
+    )
     check_close(
         centers[2],
         [50.0, -50.0],
@@ -186,7 +218,7 @@ def test_kmeans_the_final_state_is_a_fixed_point(impl):
     points = points + [612.0, -340.0, 25.0]  # away from the origin
     start = points[[0, 1, 2, 3, 4]].copy()  # five centres from one blob
     labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start), len(points), 5, 3)
-    assert n_iter < 300, "this cloud converges well before 300 iterations"
+    assert n_iter < 300, f"n_iter is {n_iter}: this cloud converges well before 300 (stop when no label changes)"
     nearest, s = _nearest(points, centers)
     _check_labels(labels, nearest, " (each point's nearest returned centre)")
     for c in np.unique(labels):
@@ -222,6 +254,42 @@ def test_kmeans_every_column_is_a_coordinate(impl):
 
 
 @pytest.mark.grades("kmeans")
+@pytest.mark.points(2)
+def test_kmeans_a_cluster_that_empties_keeps_its_centre_and_can_fill_again(impl):
+    # Equal centres at 0: the second starts empty at 0, and after the first update (centre 0 at
+    # 5.5) it takes 0 and 1 back. Then 5, 2, 6 from 2, 8, 1: cluster 0 has point 1 at the first
+    # assignment, none at the second (its centre stays at 2, not back at its start), points again
+    # later. A cluster written off for good, or sent back to its initial centre, answers otherwise.
+    _check_run(
+        impl, np.array([[0.0], [1.0], [10.0], [11.0]]), np.array([[0.0], [0.0]]), what=" (a cluster fills again)"
+    )
+    _check_run(impl, np.array([[5.0], [2.0], [6.0]]), np.array([[2.0], [8.0], [1.0]]), what=" (a cluster empties)")
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(1)
+def test_kmeans_a_near_tie_is_not_a_tie(impl):
+    # x = 1 is nearer centre 1 by a relative 1e-10: no tolerance decides a tie. And the squares,
+    # not the distances: 1 + 2^-52 against 1 are a tie once square-rooted.
+    _check_run(impl, np.array([[1.0], [-3.0], [5.0]]), np.array([[-1e-10], [2.0]]), what=" (a near-tie)")
+    points = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 5.0], [1.0, 6.0]])
+    _check_run(impl, points, np.array([[1.0, 2.0**-26], [1.0, 0.0]]), 1, " (squared distances, not distances)")
+
+
+@pytest.mark.grades("kmeans")
+@pytest.mark.points(2)
+def test_kmeans_far_from_the_origin_and_at_a_small_scale(impl):
+    # UTM-like coordinates (4.2e6 m): |x|^2 - 2 x.c + |c|^2 loses every digit of a distance there;
+    # the contract's differences do not. Then blobs a centimetre apart in kilometres.
+    rng = np.random.default_rng(4)
+    points = np.vstack([rng.normal(c, 1.0, size=(150, 3)) for c in ([0, 0, 0], [3, 0, 0], [0, 3, 0], [2, 2, 1])])
+    points = np.vstack([points, points[:40]]) + [525_000.0, 4_200_000.0, 35.0]
+    _check_run(impl, points, points[:6].copy(), what=" (far from the origin)")
+    small = np.vstack([rng.normal(c, 1.0, size=(40, 2)) for c in ([0, 0], [6, 0], [0, 6])]) * 1e-5
+    _check_run(impl, small, small[:3].copy(), what=" (a small scale)")
+
+
+@pytest.mark.grades("kmeans")
 @pytest.mark.points(1)
 @pytest.mark.interface
 def test_kmeans_converts_float32_and_modifies_nothing(impl):
@@ -251,13 +319,17 @@ def test_kmeans_rejects_bad_arguments(impl):
         ({"init_centers": np.empty((0, 3))}, "init_centers"),
         ({"init_centers": np.vstack([points, points[:1]])}, "init_centers"),
         ({"init_centers": np.full((2, 3), np.inf)}, "init_centers"),
+        ({"init_centers": start[0]}, "init_centers"),  # one centre, but 1-D
         ({"max_iter": 0}, "max_iter"),
         ({"max_iter": 2.5}, "max_iter"),
+        ({"max_iter": True}, "max_iter"),
     ]
     for change, name in cases:
         arguments = {"points": points, "init_centers": start, "max_iter": 300, **change}
         with raises(ValueError, naming=name):
             impl.kmeans(**arguments)
+    # A NumPy integer is an integer.
+    _unpack(impl.kmeans(points, start, np.int64(3)), 50, 2, 3)
 
 
 # --- kmeans_plusplus -----------------------------------------------------------------
@@ -320,6 +392,26 @@ def test_kmeans_plusplus_takes_a_generator_and_its_stream(impl):
     expected = d2_seeding(points, 6, np.random.default_rng(123))
     _check_draws(impl.kmeans_plusplus(points, 6, rng=np.random.default_rng(123)), expected, "a Generator")
     _check_draws(impl.kmeans_plusplus(points, 6, rng=123), expected, "the same seed as an int")
+    check_unmodified(impl, "kmeans_plusplus")
+
+
+@pytest.mark.grades("kmeans_plusplus")
+@pytest.mark.points(2)
+def test_kmeans_plusplus_draws_far_from_the_origin_at_a_small_scale_and_on_many_points(impl):
+    # The weights as the contract's differences, in float64: UTM-like coordinates with duplicates
+    # (the expansion |x|^2 - 2 x.c + |c|^2 loses them), blobs a centimetre apart in kilometres
+    # (no weight is "close to 0"), and 20,000 points (float32 sums lose the draws).
+    rng = np.random.default_rng(4)
+    far = np.vstack([rng.normal(c, 1.0, size=(150, 3)) for c in ([0, 0, 0], [3, 0, 0], [0, 3, 0], [2, 2, 1])])
+    far = np.vstack([far, far[:40]]) + [525_000.0, 4_200_000.0, 35.0]
+    small = np.vstack([rng.normal(c, 1.0, size=(40, 2)) for c in ([0, 0], [6, 0], [0, 6])]) * 1e-5
+    many = np.random.default_rng(0).normal(size=(20_000, 3))
+    for points, k, seed, what in (
+        (far, 25, 2, "far from the origin"),
+        (small, 4, 3, "a small scale"),
+        (many, 10, 6, "20,000 points"),
+    ):
+        _check_draws(impl.kmeans_plusplus(points, k, rng=seed), d2_seeding(points, k, seed), what)
 
 
 @pytest.mark.grades("kmeans_plusplus")
@@ -379,8 +471,13 @@ def test_kmeans_plusplus_rejects_bad_arguments(impl):
         ({"points": nan}, "points"),
         ({"points": np.empty((0, 3))}, "points"),
         ({"rng": "seed"}, "rng"),
+        ({"points": np.arange(10.0)}, "points"),  # 1-D
+        ({"points": np.array([[0.0, 1.0], [0.0, 1.0]])}, "n_clusters"),  # one distinct row
     ]
     for change, name in cases:
         arguments = {"points": points, "n_clusters": 2, "rng": 0, **change}
         with raises(ValueError, naming=name):
             impl.kmeans_plusplus(**arguments)
+    # Distinct rows, not values: four distinct points of two values; a NumPy integer is an integer.
+    square = np.array([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [1.0, 0.0]])
+    check_array(impl.kmeans_plusplus(square, np.int64(3), rng=0), "indices", shape=(3,), dtype="int64")

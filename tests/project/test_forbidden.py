@@ -95,3 +95,17 @@ def test_a_coding_line_cannot_hide_an_import_from_the_scan(tmp_path, codec):
     assert violations, f"{codec}: the scan saw nothing"
     if codec == "utf-7":
         assert any("scipy.spatial" in v.what for v in violations), violations
+
+
+def test_each_module_with_rules_of_its_own_says_why_in_its_own_words():
+    """A forbidden import in cluster.py was told 'this lecture is about writing the search' (lecture
+    2's sentence, for every module with rules of its own: a hostile review, h48h)."""
+    from grading.config import FORBIDDEN_IN_MODULE, MODULE_RULES_WHY
+    from grading.errors import VISUALISATION_ONLY, ForbiddenAPI
+
+    assert set(MODULE_RULES_WHY) == set(FORBIDDEN_IN_MODULE)
+    assert len(set(MODULE_RULES_WHY.values())) == len(MODULE_RULES_WHY)
+    for module, why in MODULE_RULES_WHY.items():
+        assert str(ForbiddenAPI(module, ["import x"])).endswith(why)
+    assert "clustering" in str(ForbiddenAPI("cluster", ["from scipy.cluster.vq import kmeans2"]))
+    assert str(ForbiddenAPI("pca", ["import sklearn"])).endswith(VISUALISATION_ONLY)
