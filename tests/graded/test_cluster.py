@@ -17,6 +17,11 @@ from sklearn.datasets import make_blobs
 
 from grading.checks import CheckFailed, as_list, check_array, check_close, check_unmodified, raises
 
+# What a wrong answer far from the origin most likely means.
+EXPANDED = (
+    "sum (p_j - c_j) ** 2 over the columns: |p|^2 - 2 p.c + |c|^2 loses every digit of a distance "
+    "at coordinates of millions"
+)
 # Centres are means: another summation order (np.add.at, bincount, a loop) moves them by a few ulps.
 CENTRES_RTOL = 1e-12
 CENTRES_ATOL = 1e-12
@@ -284,7 +289,7 @@ def test_kmeans_far_from_the_origin_and_at_a_small_scale(impl):
     rng = np.random.default_rng(4)
     points = np.vstack([rng.normal(c, 1.0, size=(150, 3)) for c in ([0, 0, 0], [3, 0, 0], [0, 3, 0], [2, 2, 1])])
     points = np.vstack([points, points[:40]]) + [525_000.0, 4_200_000.0, 35.0]
-    _check_run(impl, points, points[:6].copy(), what=" (far from the origin)")
+    _check_run(impl, points, points[:6].copy(), what=f" far from the origin ({EXPANDED})")
     small = np.vstack([rng.normal(c, 1.0, size=(40, 2)) for c in ([0, 0], [6, 0], [0, 6])]) * 1e-5
     _check_run(impl, small, small[:3].copy(), what=" (a small scale)")
 
@@ -407,7 +412,7 @@ def test_kmeans_plusplus_draws_far_from_the_origin_at_a_small_scale_and_on_many_
     small = np.vstack([rng.normal(c, 1.0, size=(40, 2)) for c in ([0, 0], [6, 0], [0, 6])]) * 1e-5
     many = np.random.default_rng(0).normal(size=(20_000, 3))
     for points, k, seed, what in (
-        (far, 25, 2, "far from the origin"),
+        (far, 25, 2, f"far from the origin: {EXPANDED}"),
         (small, 4, 3, "a small scale"),
         (many, 10, 6, "20,000 points"),
     ):
