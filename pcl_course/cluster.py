@@ -26,8 +26,9 @@ Arguments
     naming the argument. Inputs are never modified.
 
 Forbidden here
-    scikit-learn and Open3D (forbidden everywhere), and ``scipy.cluster``:
-    this lecture is about writing the algorithms. NumPy, SciPy's other
+    scikit-learn and Open3D (forbidden everywhere), ``scipy.cluster``,
+    ``hdbscan``, ``fast_hdbscan``, ``dbscan``, ``pyclustering``, ``kmeans1d``
+    and ``faiss``: this lecture is about writing the algorithms. NumPy, SciPy's other
     modules (``scipy.spatial.distance.cdist``, ...) and numba are yours.
 """
 
