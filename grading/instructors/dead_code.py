@@ -35,10 +35,15 @@ not run.
 """
 
 import ast
+from collections import Counter
 
 __all__ = ["comparable"]
 
 DEAD_CODE_ROUNDS = 5  # passes of comparable(): a dead store feeding a dead store feeding ...
+PURITY_PASSES = 4  # a module function that only calls pure ones, down to this depth, is pure
+# Names through which code reads other names by their text: a module that uses one keeps every store
+# and every definition (``locals()["_impl"](...)`` read a nested copy the normaliser dropped: h48z).
+DYNAMIC_NAMES = frozenset({"eval", "exec", "locals", "globals", "vars", "getattr", "__import__", "__dict__"})
 
 _STORES = (ast.Assign, ast.AugAssign, ast.AnnAssign)
 _SCOPES = (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)
@@ -180,16 +185,28 @@ def _pure_callees(tree):
         if all(module == "numpy" for other, module in imported if other == alias):  # np is numpy alone
             callees |= {f"{alias}.{name}" for name in PURE_NUMPY}
     other = set(stores) | arguments | {alias for alias, _ in imported}
-    once = {d.name for d in definitions if sum(e.name == d.name for e in definitions) == 1} - other
-    changed = True
-    while changed:
-        changed = False
-        for definition in definitions:
-            if definition.name in once and definition.name not in callees:
-                if _returns_only_pure(definition, frozenset(callees)):
-                    callees.add(definition.name)
-                    changed = True
+    defined = Counter(d.name for d in definitions)
+    once = {name for name, count in defined.items() if count == 1} - other
+    # A few passes, not a fixed point: a chain of n functions each calling the next took n passes of
+    # n definitions each (a 75 kB module stalled the whole report for 4 minutes: h48z).
+    for _ in range(PURITY_PASSES):
+        found = [
+            d.name for d in definitions if d.name in once and d.name not in callees and _returns_only_pure(d, callees)
+        ]
+        if not found:
+            break
+        callees.update(found)
     return frozenset(callees)
+
+
+def _reads_names_dynamically(tree):
+    """Whether ``tree`` names one of :data:`DYNAMIC_NAMES` (a call of ``eval``, ``locals()[...]``, an
+    attribute ``__dict__``): then no name can be taken as unread."""
+    return any(
+        (isinstance(node, ast.Name) and node.id in DYNAMIC_NAMES)
+        or (isinstance(node, ast.Attribute) and node.attr in DYNAMIC_NAMES)
+        for node in ast.walk(tree)
+    )
 
 
 def _stored_names(targets):
@@ -358,7 +375,10 @@ def comparable(text):
         tree = ast.parse(text)
         written = None
         for _ in range(DEAD_CODE_ROUNDS):
-            tree = _DeadCode(_read_names(tree), _pure_callees(tree)).visit(tree)
+            read = _read_names(tree)
+            if _reads_names_dynamically(tree):
+                read |= _bound_names(tree)
+            tree = _DeadCode(read, _pure_callees(tree)).visit(tree)
             previous, written = written, ast.unparse(tree)
             if written == previous:
                 break

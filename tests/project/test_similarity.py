@@ -344,3 +344,29 @@ def test_gradescope_submissions_are_named_by_their_submitters(tmp_path):
 
     page = render_report(pairs, skipped)
     assert "Dana Scully (submission_4711)" in page and "\x1b" not in page
+
+
+@pytest.mark.parametrize("reader", ['locals()["_impl"]', 'eval("_impl")'])
+def test_a_copy_reached_through_locals_or_eval_is_kept(reader, tmp_path):
+    """A hostile review (h48z): the copy nested in a function called only through locals() or eval
+    was dropped as an unused definition, and the pair vanished from the report."""
+    body = textwrap.dedent(ALICE).strip()
+    hidden = "def _impl(points, correlation, sort):\n" + textwrap.indent(body, "    ") + "\n"
+    hidden += f"return {reader}(points, correlation, sort)"
+    for name, text in (("alice", ALICE), ("mallory", hidden), ("carol", CAROL), ("dave", DAVE)):
+        student(tmp_path, name, text)
+    pairs, _ = compare_class(tmp_path)
+    assert {pairs[0].first, pairs[0].second} == {"alice", "mallory"} and pairs[0].similarity > 0.7, pairs[0]
+
+
+def test_a_long_chain_of_functions_is_normalised_in_linear_time():
+    """A hostile review (h48z): 2,400 functions each returning the next one's call took the fixed
+    point of purity n passes of n definitions: 4 minutes for one module, the whole report waiting."""
+    import time
+
+    from grading.instructors.dead_code import comparable
+
+    chain = "".join(f"def f{i}():\n    return f{i + 1}()\n\n" for i in range(2400)) + "def f2400():\n    return 0\n"
+    started = time.process_time()
+    comparable(chain)
+    assert time.process_time() - started < 10
