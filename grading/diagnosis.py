@@ -17,7 +17,9 @@ this order, and stops at the first finding:
    inputs, and is named when the student's answers equal its predictions on
    the calls where it differs from the right answer, in more failed tests
    than contradict it, and in at least as many as fail where it would have
-   answered right (those show another fault);
+   answered right (those show another fault); where the right answer is
+   unique, a right answer is no evidence either way, and the mistakes are
+   replayed on it only to break a tie (:func:`grading.matching.best_mistake`);
 5. every failed test expecting a ``ValueError`` the function did not raise;
    or every failed test breaking one and the same rule.
 

@@ -149,24 +149,88 @@ def _verdict(model, mistake, call, arguments, truth):
     return CONTRADICTED, None
 
 
-def _verdicts(model, kept, memo):
-    """``{(id(mistake), id(call)): verdict}`` for every mistake of ``model`` and every kept call
-    (``(call, arguments)``), computed once per pair: ``memo`` keeps them for another diagnosis of
-    the same calls (a grading diagnoses the public tests' calls, then all of them). The truth of a
-    call is computed only for a call whose verdicts are not there yet."""
+def _truth(model, arguments):
+    """The call's right answer, or None on an input the contract rejects (nothing to compare)."""
+    try:
+        return model.truth(**copy.deepcopy(arguments))
+    except Exception:
+        return None
+
+
+def _is_right(model, call, arguments, truth):
+    """Whether the call answered the one right answer: never for a random truth, or for a model whose
+    right answers are many (``Model.unique_truth`` False: a set of acceptable draws)."""
+    if not getattr(model, "unique_truth", True) or truth is None or truth is RANDOM:
+        return False
+    return not _wrong(call, truth, model, arguments)
+
+
+def _deferred(mistake, right):
+    """Whether a (mistake, call) verdict waits until a tie needs it: a right answer of a unique truth,
+    compared by the model's ``same``, is ABSENT or NO_EVIDENCE for every deterministic mistake (a
+    prediction that differs from the truth differs from the answer), so it is no evidence for or
+    against and only breaks a tie (:func:`best_mistake`). A mistake with its own ``same`` may compare
+    more loosely: its verdicts on right answers are taken at once."""
+    return right and mistake.same is None
+
+
+def _verdicts(model, kept, memo, mistakes, deferred=False):
+    """``{(id(mistake), id(call)): verdict}`` for ``mistakes`` and the kept calls (``(call,
+    arguments)``), computed once per pair: ``memo`` keeps them for another diagnosis of the same calls
+    (a grading diagnoses the public tests' calls, then all of them), and whether each call answered
+    right (``("right", id(call))``). ``deferred``: the pairs :func:`_deferred` left, else the others.
+    The truth of a call is computed only for a call with a verdict to find."""
     for call, arguments in kept:
-        if all((id(mistake), id(call)) in memo for mistake in model.mistakes):
-            continue
-        try:
-            truth = model.truth(**copy.deepcopy(arguments))
-        except Exception:  # an input the contract rejects: nothing to compare
-            truth = None
-        for mistake in model.mistakes:
+        right = memo.get(("right", id(call)))
+        if right is not None:
+            wanted = [m for m in mistakes if (id(m), id(call)) not in memo and _deferred(m, right) == deferred]
+            if not wanted:
+                continue
+        truth = _truth(model, arguments)
+        if right is None:
+            right = memo["right", id(call)] = _is_right(model, call, arguments, truth)
+            wanted = [m for m in mistakes if (id(m), id(call)) not in memo and _deferred(m, right) == deferred]
+        for mistake in wanted:
             if truth is None:
                 memo[id(mistake), id(call)] = (NO_EVIDENCE, None)
             else:
-                memo.setdefault((id(mistake), id(call)), _verdict(model, mistake, call, arguments, truth))
+                memo[id(mistake), id(call)] = _verdict(model, mistake, call, arguments, truth)
     return memo
+
+
+def _tally(function, mistake, kept, verdicts, failed):
+    """What the verdicts of ``mistake`` say, over every call: ``(explained, contradicted, unexplained,
+    absent, evidence)``, or None where the mistake is rejected (wrong where it gives the right answer,
+    for an exclusive mistake). A pair not in ``verdicts`` (deferred) counts as no evidence."""
+    matched, contradicted, luck, seen = set(), set(), {}, {}
+    wrong_where_right = set()  # tests with a wrong answer where the mistake gives the right one
+    evidence, absent = 0, 0  # calls the mistake predicts; calls where it differs and the answer is right
+    for call, _ in kept:
+        kind, detail = verdicts.get((id(mistake), id(call)), (NO_EVIDENCE, None))
+        if kind == REJECTS:
+            _debug(function, mistake.id, "wrong where the mistake is right", call.test)
+            return None
+        if kind == WRONG_WHERE_RIGHT:
+            wrong_where_right.add(call.test)
+        elif kind == MATCHED:
+            matched.add(call.test)
+            evidence += 1
+            # A random method's right answer may equal the mistake's by chance: a test is
+            # evidence only when that chance, over all of its calls, is small.
+            # Calls with the same arguments (the same seed) are one draw, not several.
+            key, chance = detail
+            if key not in seen.setdefault(call.test, set()):
+                seen[call.test].add(key)
+                luck[call.test] = luck.get(call.test, 1.0) * chance
+        elif kind == ABSENT:
+            absent += 1
+        elif kind == CONTRADICTED:
+            _debug(function, mistake.id, "does not match its prediction", call.test)
+            contradicted.add(call.test)
+    # A test is explained when the mistake predicts its answers and nothing contradicts it there.
+    explained = tuple(t for t in failed if t in matched and t not in contradicted and luck.get(t, 0.0) < CHANCE_LIMIT)
+    unexplained = [t for t in failed if t in wrong_where_right and t not in matched and t not in contradicted]
+    return explained, contradicted, unexplained, absent, evidence
 
 
 def best_mistake(function, model, kept, failed, memo):
@@ -175,48 +239,23 @@ def best_mistake(function, model, kept, failed, memo):
 
     ``kept`` is the function's recorded calls with their bound arguments
     (``(call, arguments)``); ``memo`` keeps the verdicts for another
-    diagnosis of the same calls (:func:`_verdicts`).
+    diagnosis of the same calls (:func:`_verdicts`). A mistake is named when
+    it explains more tests than contradict it, and at least as many as fail
+    where it would have answered right (the code then has another fault:
+    naming this one would send the student after a mistake the failures do
+    not show). The most explained, then the fewest contradicting, win; a tie
+    goes to the mistake that differs from fewer right answers, then to the
+    one with more matched calls: those right answers' verdicts are computed
+    for the tied mistakes only (:func:`_deferred`), as most of a grading's
+    calls are right and each verdict replays the mistake.
     """
-    verdicts = _verdicts(model, kept, memo)
-    best, best_key = None, None
+    verdicts = _verdicts(model, kept, memo, model.mistakes)
+    candidates = []
     for mistake in model.mistakes:
-        matched, contradicted, luck, seen = set(), set(), {}, {}
-        wrong_where_right = set()  # tests with a wrong answer where the mistake gives the right one
-        evidence, absent = 0, 0  # calls the mistake predicts; calls where it differs and the answer is right
-        rejected = False
-        for call, _ in kept:
-            kind, detail = verdicts[id(mistake), id(call)]
-            if kind == REJECTS:
-                _debug(function, mistake.id, "wrong where the mistake is right", call.test)
-                rejected = True
-                break
-            if kind == WRONG_WHERE_RIGHT:
-                wrong_where_right.add(call.test)
-            elif kind == MATCHED:
-                matched.add(call.test)
-                evidence += 1
-                # A random method's right answer may equal the mistake's by chance: a test is
-                # evidence only when that chance, over all of its calls, is small.
-                # Calls with the same arguments (the same seed) are one draw, not several.
-                key, chance = detail
-                if key not in seen.setdefault(call.test, set()):
-                    seen[call.test].add(key)
-                    luck[call.test] = luck.get(call.test, 1.0) * chance
-            elif kind == ABSENT:
-                absent += 1
-            elif kind == CONTRADICTED:
-                _debug(function, mistake.id, "does not match its prediction", call.test)
-                contradicted.add(call.test)
-        if rejected:
+        tally = _tally(function, mistake, kept, verdicts, failed)
+        if tally is None:
             continue
-        # A test is explained when the mistake predicts its answers and nothing contradicts it
-        # there; the mistake is named when it explains more tests than contradict it, and at least
-        # as many as fail where it would have answered right (the code then has another fault:
-        # naming this one would send the student after a mistake the failures do not show).
-        explained = tuple(
-            t for t in failed if t in matched and t not in contradicted and luck.get(t, 0.0) < CHANCE_LIMIT
-        )
-        unexplained = [t for t in failed if t in wrong_where_right and t not in matched and t not in contradicted]
+        explained, contradicted, unexplained = tally[:3]
         _debug(
             function,
             mistake.id,
@@ -225,7 +264,20 @@ def best_mistake(function, model, kept, failed, memo):
             "all",
         )
         if explained and len(explained) > len(contradicted) and len(explained) >= len(unexplained):
-            key = (len(explained), -len(contradicted), -absent, evidence)
-            if best_key is None or key > best_key:
-                best, best_key = (mistake, explained), key
+            candidates.append((mistake, (len(explained), -len(contradicted))))
+    if not candidates:
+        return None
+    top = max(key for _, key in candidates)
+    tied = [mistake for mistake, key in candidates if key == top]
+    if len(tied) > 1:
+        verdicts = _verdicts(model, kept, memo, tied, deferred=True)
+    best, best_key = None, None
+    for mistake in tied:
+        tally = _tally(function, mistake, kept, verdicts, failed)
+        if tally is None:
+            continue
+        explained, contradicted, _, absent, evidence = tally
+        key = (len(explained), -len(contradicted), -absent, evidence)
+        if best_key is None or key > best_key:
+            best, best_key = (mistake, explained), key
     return best

@@ -406,6 +406,34 @@ def test_known_mistake_prefers_more_explained_then_fewer_contradicting_then_fewe
     assert run(_known_mistake, absent, {**failed("t1", "t2"), **passed("t3")}, model=catalogue(SUMS)).id == "sums"
 
 
+def test_known_mistake_replays_right_answers_only_to_break_a_tie():
+    """A right answer of a unique truth is no evidence: the mistakes are replayed on it only when
+    two of them tie (most of a grading's calls are right, and each replay runs the mistake); a
+    model whose right answers are many (a random method's draws) replays them at once."""
+    replayed = []
+
+    def recorded(predict):
+        def replay(points, **_):
+            replayed.append(len(points))
+            return predict(points)
+
+        return replay
+
+    sums_seen, big_seen = Mistake("sums", "sums", recorded(sums)), Mistake("big_sums", "big", recorded(half_sums))
+    wrong = [answered("t1", cloud(3), sums(cloud(3))), answered("t2", cloud(3, shift=1), sums(cloud(3, shift=1)))]
+    right = [answered("t3", cloud(2), means(cloud(2)))]
+    outcomes = {**failed("t1", "t2"), **passed("t3")}
+    assert run(_known_mistake, wrong + right, outcomes, model=catalogue(sums_seen)).id == "sums"
+    assert replayed == [3, 3]  # the right answer (2 points) is not replayed: one candidate
+    replayed.clear()
+    assert run(_known_mistake, wrong + right, outcomes, model=catalogue(sums_seen, big_seen)).id == "big_sums"
+    assert sorted(replayed) == [2, 2, 3, 3, 3, 3]  # a tie: both replayed on the right answer
+    replayed.clear()
+    many = catalogue(sums_seen, unique_truth=False)
+    assert run(_known_mistake, wrong + right, outcomes, model=many).id == "sums"
+    assert sorted(replayed) == [2, 3, 3]
+
+
 # -- 4. the catalogue: the guards -----------------------------------------------------------------
 
 

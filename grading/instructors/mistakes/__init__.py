@@ -62,12 +62,21 @@ def _default_same(a, b, arguments):
 
 @dataclass(frozen=True)
 class Model:
-    """A graded function in the catalogue (see the module docstring)."""
+    """A graded function in the catalogue (see the module docstring).
+
+    ``unique_truth``: the contract's answer is one (up to ``same``), so a
+    right answer is no evidence for or against a mistake
+    (:func:`grading.matching.best_mistake` replays the mistakes on right
+    answers only to break a tie); False where many answers are right (a
+    random method whose truth is the set of acceptable draws): a right
+    answer that differs from a mistake's prediction then contradicts it.
+    """
 
     truth: object
     mistakes: tuple = field(default_factory=tuple)
     same: object = _default_same
     output_dtypes: tuple = None
+    unique_truth: bool = True
 
 
 def model(function):

@@ -482,6 +482,7 @@ NORMAL_SPACE_SAMPLING = Model(
     truth=sampling,
     same=_sampling_same,
     output_dtypes=("int64",),
+    unique_truth=False,  # the truth is the set of draws the contract allows
     mistakes=(
         Mistake(
             "index_order_in_bucket",
