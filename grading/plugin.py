@@ -16,7 +16,6 @@ import importlib
 import json
 import os
 import signal
-import tempfile
 import time
 from pathlib import Path
 
@@ -34,7 +33,7 @@ from grading.errors import SandboxError, TestTimeout  # noqa: E402
 from grading.feedback import classify  # noqa: E402
 from grading.implementation import Implementation  # noqa: E402
 from grading.options import MARKERS, PLUGIN_ONLY, SHARED  # noqa: E402
-from grading.results import Grading, TestResult, clean  # noqa: E402
+from grading.results import Grading, TestResult, clean, write_atomically  # noqa: E402
 
 # The catalogue of known mistakes: the instructors' grader only (a student's copy has none).
 mistakes = importlib.import_module("grading.instructors.mistakes") if instructors_grader() else None
@@ -44,6 +43,7 @@ _RESULTS_KEY = pytest.StashKey[dict]()
 _OUTCOMES_KEY = pytest.StashKey[dict]()  # test id -> diagnosis.Outcome
 _DIAGNOSES_KEY = pytest.StashKey[dict]()  # function -> its diagnosis, once the tests are over
 _STARTED_KEY = pytest.StashKey[float]()
+_COLLECTED_KEY = pytest.StashKey[dict]()  # test id -> its place in the collected order (the results' order)
 _ALARM_KEY = pytest.StashKey[object]()  # a graded test's previous SIGALRM handler, while its timer runs
 _IN_CALL_KEY = pytest.StashKey[bool]()  # a graded test's call is under way (the only phase that runs submissions)
 _FIRED_KEY = pytest.StashKey[bool]()  # its timer has gone off
@@ -160,6 +160,26 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if _is_graded(item) and item.get_closest_marker("timeout") is None:
             item.add_marker(pytest.mark.timeout(grading_config.TEST_TIMEOUT))
+    # The tests of modules under the same rules run together: a module with rules of its own runs in
+    # a worker of its own, and each switch restarts the sandbox's worker (its imports and its numba
+    # compilations again). The results keep the collected order (pytest_collection_finish).
+    config.stash[_COLLECTED_KEY] = {item.nodeid: place for place, item in enumerate(items)}
+    items[:] = sorted(items, key=_first_of_its_rules(items))
+
+
+def _rules_of(item):
+    """The rules an item's function runs under: its module's own forbidden names (none: the general rules)."""
+    if not _is_graded(item):
+        return None
+    return tuple(grading_config.FORBIDDEN_IN_MODULE.get(GRADED_FUNCTIONS[graded_function(item)], ()))
+
+
+def _first_of_its_rules(items):
+    """A sort key: the place of the first item under the same rules (a stable sort groups them)."""
+    first = {}
+    for place, item in enumerate(items):
+        first.setdefault(_rules_of(item), place)
+    return lambda item: first[_rules_of(item)]
 
 
 def _run_diagnosis(config, function, tests, always, memo):
@@ -255,6 +275,8 @@ def pytest_collection_finish(session):
     complete, valid results file."""
     results = session.config.stash[_RESULTS_KEY]
     graded = [item for item in session.items if _is_graded(item) and graded_function(item) in GRADED_FUNCTIONS]
+    collected = session.config.stash.get(_COLLECTED_KEY, {})
+    graded.sort(key=lambda item: collected.get(item.nodeid, len(collected)))
     several = len({grading_config.ASSIGNMENT_NUMBERS[graded_function(item)] for item in graded}) > 1
     counts = {}
     for item in graded:  # unmarked ones stopped the run already
@@ -432,13 +454,8 @@ def _write_results(config, final=True):
     path = grading_option(config, "results")
     if not path or hasattr(config, "workerinput"):
         return
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     content = grading_of(config).to_gradescope()
-    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    with os.fdopen(fd, "w") as handle:
-        handle.write(json.dumps(content, indent=2 if final else None))
-    os.replace(temporary, path)
+    write_atomically(path, json.dumps(content, indent=2 if final else None))
 
 
 def pytest_unconfigure(config):

@@ -134,8 +134,11 @@ def per_function(results):
 def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     """For every graded function: answers computed on a rewritten input score no more when the
     call also writes that input into the grader's arrays (the grader computes from a frozen copy)."""
-    honest, _ = run_grader("--reference", *honest_overrides(tmp_path / "honest"), tmp_path=tmp_path / "honest")
-    cheat, _ = run_grader(str(rewriting_submission(tmp_path / "cheat", True)), tmp_path=tmp_path / "cheat")
+    # The marks and the in-place tests' own lines are checked here, not the diagnosis (every answer is wrong).
+    honest_args = ("--reference", "--no-diagnosis", *honest_overrides(tmp_path / "honest"))
+    honest, _ = run_grader(*honest_args, tmp_path=tmp_path / "honest")
+    cheat_args = (str(rewriting_submission(tmp_path / "cheat", True)), "--no-diagnosis")
+    cheat, _ = run_grader(*cheat_args, tmp_path=tmp_path / "cheat")
     assert cheat["grading"].isolation.startswith("isolated")
     honest_totals, cheat_totals = per_function(honest), per_function(cheat)
     assert set(cheat_totals) == set(GRADED_FUNCTIONS)
