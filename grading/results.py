@@ -26,12 +26,60 @@ points, and for a hidden test which rule it broke, never a value of its
 inputs and no text its call produced.
 """
 
+import os
 import re
+import secrets
 import unicodedata
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from grading.config import GRADED_FUNCTIONS, MAX_OUTPUT, MAX_OUTPUT_LINES, MAX_TEXT
 from grading.hidden import hidden_points
+
+
+def write_atomically(path, text):
+    """Write ``text`` to ``path``, readable by its owner only: a reader sees the old file or the
+    whole new one, and a grader killed meanwhile leaves no half-written file beside it.
+
+    The text goes to an unnamed file (Linux's ``O_TMPFILE``), named only for
+    the instant between its link and the rename; where that is not available,
+    to a named temporary file.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data = text.encode()
+    temporary = path.parent / f".{path.name}.{secrets.token_hex(6)}"
+    if not _linked_unnamed_file(path.parent, data, temporary):
+        fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        try:
+            _write_all(fd, data)
+        finally:
+            os.close(fd)
+    os.replace(temporary, path)
+
+
+def _linked_unnamed_file(folder, data, name):
+    """Write ``data`` to an unnamed file in ``folder``, then give it ``name``; False where the
+    system cannot (no ``O_TMPFILE`` on this file system, no ``/proc``)."""
+    try:
+        fd = os.open(folder, os.O_TMPFILE | os.O_WRONLY, 0o600)
+    except (AttributeError, OSError):
+        return False
+    try:
+        _write_all(fd, data)
+        os.link(f"/proc/self/fd/{fd}", name, follow_symlinks=True)
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
+    return True
+
+
+def _write_all(fd, data):
+    view = memoryview(data)
+    while view:
+        view = view[os.write(fd, view) :]
+
 
 NOT_RUN = "not run: grading stopped before this test"
 HIDDEN_NOTE = "(hidden test: details withheld)"

@@ -38,7 +38,7 @@ from grading.errors import NothingToGrade, StagingError
 from grading.instructors.leakcheck import find_leaks
 from grading.instructors.reports import say
 from grading.instructors.shipping import IGNORED, cut_reference_link
-from grading.results import Grading, clean
+from grading.results import Grading, clean, write_atomically
 from grading.runner import run_graded_tests
 from grading.staging import read_regular_file, stage
 
@@ -321,11 +321,7 @@ def _failure_results(message, started):
 
 
 def _write_json(path, content):
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
-    with os.fdopen(fd, "w") as handle:
-        json.dump(content, handle, indent=2)
-    os.replace(temporary, path)
+    write_atomically(path, json.dumps(content, indent=2))
 
 
 def seal_platform_files(root):

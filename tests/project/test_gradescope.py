@@ -16,6 +16,7 @@ import os
 import shutil
 import signal
 import socket
+import stat
 import subprocess
 import sys
 import time
@@ -356,3 +357,19 @@ def test_lecture_3s_archive_gives_the_reference_full_marks_as_a_dedicated_uid(tm
     ][:2]
     assert results["grading"].isolation.startswith("isolated: dedicated uid")
     assert "Traceback" not in printed
+
+
+@pytest.mark.parametrize("unnamed", [True, False])
+def test_results_are_written_whole_and_leave_nothing_beside_them(tmp_path, monkeypatch, unnamed):
+    """The results file is replaced whole, readable by the grader only; the text is written to an
+    unnamed file (a grader killed while writing leaves no half file), or a named one where the
+    system has no O_TMPFILE."""
+    from grading import results
+
+    if not unnamed:
+        monkeypatch.delattr(results.os, "O_TMPFILE")
+    target = tmp_path / "results" / "results.json"
+    for text in ("{}", '{"score": 1}'):
+        results.write_atomically(target, text)
+    assert target.read_text() == '{"score": 1}' and stat.S_IMODE(target.stat().st_mode) == 0o600
+    assert [p.name for p in target.parent.iterdir()] == ["results.json"]
