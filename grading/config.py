@@ -45,6 +45,7 @@ ASSIGNMENTS = {
     "lecture3": {
         "kmeans": "cluster",
         "kmeans_plusplus": "cluster",
+        "dbscan": "cluster",
     },
 }
 GRADED_FUNCTIONS = {function: module for graded in ASSIGNMENTS.values() for function, module in graded.items()}

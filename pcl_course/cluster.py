@@ -1,17 +1,22 @@
-"""Exercises of lecture 3: clustering (k-means and its seeding).
+"""Exercises of lecture 3: clustering (k-means and its seeding, DBSCAN).
 
 The rules of this module (the course's contract, on top of the general rules):
 
 Points and distances
-    ``points`` is (N, D), D >= 1, N >= 1; every column is a coordinate.
+    ``points`` is (N, D), D >= 1, N >= 1 (N >= 0 for :func:`dbscan`, whose
+    empty cloud has empty labels); every column is a coordinate.
     Everything is computed in float64 (float32 input is converted). The
-    squared distance of a point p to a centre c is
+    squared distance of a point p to a centre (or point) c is
     ``s = sum_j (p_j - c_j) ** 2`` over the columns, in increasing j (as in
     lecture 2).
 
+Labels
+    int64, clusters numbered 0, 1, ..., noise -1; each function states its
+    numbering, so that answers compare exactly, with no matching of labels.
+
 Ties
-    Wherever a rule takes a minimum over centres, **ties go to the lowest
-    index**.
+    Wherever a rule takes a minimum over centres or labels, **ties go to
+    the lowest index**.
 
 Randomness
     :func:`kmeans` is deterministic: it starts from the centres it is given.
@@ -22,7 +27,8 @@ Randomness
 
 Arguments
     Anything else than the documented shapes, non-finite values, a number of
-    clusters outside its range or a ``max_iter`` below 1 is a ``ValueError``
+    clusters outside its range, a ``max_iter`` or ``min_samples`` below 1 or
+    an ``eps`` that is not a positive finite number is a ``ValueError``
     naming the argument. Inputs are never modified.
 
 Forbidden here
@@ -37,7 +43,7 @@ import numpy as np  # noqa: F401
 
 from pcl_course.validation import as_array, as_points, check_integer, check_rng  # noqa: F401
 
-__all__ = ["kmeans", "kmeans_plusplus"]
+__all__ = ["kmeans", "kmeans_plusplus", "dbscan"]
 
 
 def kmeans(points, init_centers, max_iter=300):
@@ -134,3 +140,53 @@ def kmeans_plusplus(points, n_clusters, rng=None):
         ``1 ..`` the number of distinct points; a bad ``rng``.
     """
     raise NotImplementedError("kmeans_plusplus: not implemented yet")
+
+
+def dbscan(points, eps, min_samples):
+    """DBSCAN: clusters of density-connected points, and noise.
+
+    With ``N(p) = {q : s(p, q) <= eps ** 2}``, the points within ``eps`` of
+    p, **p itself included** (and every duplicate of p):
+
+    1. p is a **core** point iff ``|N(p)| >= min_samples``.
+    2. The **clusters** are the connected components of the core points,
+       two core points p and q being linked when q is in N(p). They are
+       numbered by their smallest core index: the cluster of the lowest
+       core point is 0, the cluster of the lowest core point not in it is
+       1, and so on.
+    3. A point that is not core but has a core point in N(p) is a
+       **border** point: it takes the **smallest** label among the
+       clusters of its core neighbours (it may touch several).
+    4. Every other point is **noise**, labelled -1.
+
+    The answer depends on no visiting order. The neighbourhood is
+    inclusive: two points exactly ``eps`` apart are neighbours
+    (scikit-learn's ``DBSCAN`` follows these rules; Open3D's
+    ``cluster_dbscan`` takes ``s < eps ** 2``).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+        The points, N >= 0, D >= 1.
+    eps : float
+        The neighbourhood's radius, in the points' units; positive and
+        finite.
+    min_samples : int
+        The number of points (itself included) within ``eps`` that makes a
+        point core, >= 1 (1: every point is core, and the clusters are the
+        connected components of the ``eps``-graph).
+
+    Returns
+    -------
+    labels : ndarray of int64, shape (N,)
+        Each point's cluster (numbered as in 2.), or -1 for noise.
+    is_core : ndarray of bool, shape (N,)
+        Whether each point is a core point.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points`` (shape, non-finite); ``eps`` not a positive finite
+        number; ``min_samples`` not an integer >= 1.
+    """
+    raise NotImplementedError("dbscan: not implemented yet")

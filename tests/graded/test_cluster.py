@@ -486,3 +486,246 @@ def test_kmeans_plusplus_rejects_bad_arguments(impl):
     # Distinct rows, not values: four distinct points of two values; a NumPy integer is an integer.
     square = np.array([[0.0, 0.0], [1.0, 1.0], [0.0, 1.0], [1.0, 0.0]])
     check_array(impl.kmeans_plusplus(square, np.int64(3), rng=0), "indices", shape=(3,), dtype="int64")
+
+
+# --- dbscan ----------------------------------------------------------------------------
+
+
+def neighbourhoods(points, eps):
+    """The contract's N(p) of every point, itself included: a list of index arrays (brute force)."""
+    points = np.asarray(points, dtype=float)
+    s = sum((points[:, j, None] - points[None, :, j]) ** 2 for j in range(points.shape[1]))
+    return [np.flatnonzero(row <= eps * eps) for row in s]
+
+
+def density_clusters(points, eps, min_samples):
+    """The contract's answer, written from its rules: cores by |N(p)|, clusters the connected
+    components of the cores numbered by their smallest core, a border the smallest label it touches."""
+    near = neighbourhoods(points, eps)
+    is_core = np.array([len(n) >= min_samples for n in near], dtype=bool)
+    labels = np.full(len(near), -1, dtype=np.int64)
+    cluster = 0
+    for seed in np.flatnonzero(is_core):  # the smallest core index first
+        if labels[seed] >= 0:
+            continue
+        labels[seed], frontier = cluster, [seed]
+        while frontier:
+            p = frontier.pop()
+            for q in near[p]:
+                if is_core[q] and labels[q] < 0:
+                    labels[q] = cluster
+                    frontier.append(q)
+        cluster += 1
+    for p in np.flatnonzero(~is_core):
+        touched = [labels[q] for q in near[p] if is_core[q]]
+        labels[p] = min(touched) if touched else -1
+    return labels, is_core
+
+
+def _scikit_learn_dbscan(points, eps, min_samples):
+    from sklearn.cluster import DBSCAN
+
+    fitted = DBSCAN(eps=eps, min_samples=min_samples).fit(points)
+    is_core = np.zeros(len(points), dtype=bool)
+    is_core[fitted.core_sample_indices_] = True
+    return fitted.labels_.astype(np.int64), is_core
+
+
+def _unpack_dbscan(result, n):
+    if not isinstance(result, tuple) or len(result) != 2:
+        raise CheckFailed(f"dbscan must return a tuple (labels, is_core), got {type(result).__name__}")
+    labels, is_core = result
+    check_array(labels, "labels", shape=(n,), dtype="int64")
+    check_array(is_core, "is_core", shape=(n,), dtype="bool")
+    return labels, is_core
+
+
+def _check_dbscan(impl, points, eps, min_samples, expected=None, what=""):
+    """Call dbscan and compare with ``expected`` (the tests' own rules by default), naming the first
+    point that differs and the rule it breaks."""
+    labels, is_core = _unpack_dbscan(impl.dbscan(points, eps, min_samples), len(points))
+    want_labels, want_core = density_clusters(points, eps, min_samples) if expected is None else expected
+    near = None
+    if not np.array_equal(is_core, want_core):
+        near = neighbourhoods(points, eps)
+        p = int(np.argmax(is_core != want_core))
+        raise CheckFailed(
+            f"point {p} has {len(near[p])} points within eps (itself and its duplicates included, a distance "
+            f"equal to eps included), min_samples = {min_samples}: it is {'' if want_core[p] else 'not '}core, "
+            f"yours says it is{'' if is_core[p] else ' not'}{what}",
+            rule="core points are those with |N(p)| >= min_samples",
+        )
+    if np.array_equal(labels, want_labels):
+        return labels, is_core
+    p = int(np.argmax(labels != want_labels))
+    if want_core[p]:
+        clusters = want_labels[want_core]
+        first = [int(np.flatnonzero(want_core & (want_labels == c))[0]) for c in range(clusters.max() + 1)]
+        raise CheckFailed(
+            f"core point {p} has label {labels[p]}, expected {want_labels[p]}{what}: the clusters are the connected "
+            "components of the core points, numbered by their smallest core index (here the clusters' smallest "
+            f"cores are {as_list(first, 6)})",
+            rule="clusters are numbered by their smallest core point",
+        )
+    near = neighbourhoods(points, eps) if near is None else near
+    touched = sorted({int(want_labels[q]) for q in near[p] if want_core[q]})
+    if not touched:
+        raise CheckFailed(
+            f"point {p} is noise (no core point within eps), yours labels it {labels[p]}{what}: noise is -1",
+            rule="noise is -1",
+        )
+    raise CheckFailed(
+        f"border point {p} touches the clusters {as_list(touched, 6)} through its core neighbours, yours labels it "
+        f"{labels[p]}{what}: a border point takes the smallest label among its core neighbours' clusters",
+        rule="a border point takes the smallest label it touches",
+    )
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_dbscan_returns_int64_labels_and_boolean_cores(impl):
+    points = _blobs(200, centres=3, columns=3, seed=11)
+    _unpack_dbscan(impl.dbscan(points, 1.0, 5), 200)
+    labels, is_core = _unpack_dbscan(impl.dbscan(np.empty((0, 3)), 1.0, 5), 0)  # an empty cloud: empty labels
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(3)
+def test_dbscan_on_a_line_worked_by_hand(impl):
+    # eps = 1 and min_samples = 3: 1, 2 and 8 have 3 points within 1 (themselves included) and are core;
+    # 0 and 3 border the first cluster, 7 and 9 the second; 20 is noise. Neighbours 1 apart are at
+    # exactly eps: the neighbourhood is inclusive.
+    points = np.array([[0.0], [1.0], [2.0], [3.0], [7.0], [8.0], [9.0], [20.0]])
+    expected = (np.array([0, 0, 0, 0, 1, 1, 1, -1]), np.array([0, 1, 1, 0, 0, 1, 0, 0], dtype=bool))
+    _check_dbscan(impl, points, 1.0, 3, expected, " (a line worked by hand)")
+    # min_samples = 1: every point is core, each run of points 1 apart a cluster.
+    expected = (np.array([0, 0, 0, 0, 1, 1, 1, 2]), np.ones(8, dtype=bool))
+    _check_dbscan(impl, points, 1.0, 1, expected, " (min_samples = 1)")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(2)
+def test_dbscan_a_border_point_takes_the_smallest_label_it_touches(impl):
+    # Two runs of points 0.5 apart, cores 1.5..3 and 5..6.5 (eps = 1, min_samples = 4); point 0, at 4, is
+    # within eps of a core of each but has only 3 points within eps: a border point of both clusters.
+    # Listed first, the right run's cores come before the left's: the right run is cluster 0.
+    right = [5.0, 5.5, 6.0, 6.5, 7.0]
+    left = [1.0, 1.5, 2.0, 2.5, 3.0]
+    points = np.array([[4.0], *([x] for x in right), *([x] for x in left)])
+    labels, _ = _check_dbscan(impl, points, 1.0, 4, what=" (a border point between two clusters)")
+    assert labels[0] == 0 and labels[1] == labels[2] == 0 and labels[-2] == 1  # the test's own premise
+    mirrored = points[::-1].copy()  # the left run's cores first now: it is cluster 0, and so is the border
+    _check_dbscan(impl, mirrored, 1.0, 4, what=" (the same points in reverse order)")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(3)
+def test_dbscan_matches_scikit_learn(impl):
+    from sklearn.datasets import make_moons
+
+    moons, _ = make_moons(600, noise=0.08, random_state=3)
+    noise = np.random.default_rng(3).uniform([-1.5, -1.0], [2.5, 1.5], size=(60, 2))
+    cases = [
+        (np.vstack([moons, noise]), 0.12, 5),
+        (_blobs(800, centres=5, columns=3, seed=12), 0.9, 8),
+        (_blobs(500, centres=4, columns=2, seed=13), 0.4, 1),
+        (_blobs(400, centres=3, columns=3, seed=14), 2.5, 30),
+    ]
+    for points, eps, min_samples in cases:
+        expected = _scikit_learn_dbscan(points, eps, min_samples)
+        _check_dbscan(impl, points, eps, min_samples, expected, f" (eps = {eps}, min_samples = {min_samples})")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(2)
+def test_dbscan_on_the_scan_without_its_ground(impl):
+    from pcl_course.datasets import LIDAR_CLASSES, simulate_lidar_scan
+
+    scan = simulate_lidar_scan(seed=5, n_azimuth=900)
+    above = scan.points[(scan.labels != LIDAR_CLASSES.index("ground")) & (np.linalg.norm(scan.points, axis=1) < 30)]
+    points = above[np.random.default_rng(5).choice(len(above), min(3000, len(above)), replace=False)]
+    for eps, min_samples in ((0.5, 4), (1.0, 10)):
+        expected = _scikit_learn_dbscan(points, eps, min_samples)
+        _check_dbscan(impl, points, eps, min_samples, expected, f" (the scan, eps = {eps} m)")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(2)
+def test_dbscan_numbers_clusters_by_their_smallest_core(impl):
+    # A border point of the second cluster comes first: numbering by the first point of each cluster
+    # (any point) would call the second cluster 0.
+    grid = np.stack(np.meshgrid(np.arange(4.0), np.arange(4.0)), -1).reshape(-1, 2)
+    points = np.vstack([[[10.0, 1.5]], grid, grid + [10.0, 3.0]])
+    _check_dbscan(impl, points, 1.0, 4, what=" (a border point listed first)")
+    shuffled = _blobs(600, centres=6, columns=2, seed=15)[np.random.default_rng(15).permutation(600)]
+    _check_dbscan(impl, shuffled, 0.6, 6, _scikit_learn_dbscan(shuffled, 0.6, 6), " (shuffled blobs)")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(2)
+def test_dbscan_counts_the_point_itself_and_its_duplicates(impl):
+    # Point 0 has 3 duplicates: 4 points at distance 0, so it is core for min_samples 4, not 5.
+    base = np.array([[0.0, 0.0, 0.0]] * 4 + [[5.0, 0.0, 0.0], [5.0, 0.0, 0.0], [9.0, 9.0, 9.0]])
+    for min_samples in (2, 3, 4, 5):
+        _check_dbscan(impl, base, 0.1, min_samples, what=f" (duplicate points, min_samples = {min_samples})")
+    # On a unit grid with eps = 1 the four grid neighbours lie at exactly eps: 5 points with itself.
+    grid = np.stack(np.meshgrid(np.arange(6.0), np.arange(5.0)), -1).reshape(-1, 2)
+    for min_samples in (4, 5, 6):
+        _check_dbscan(impl, grid, 1.0, min_samples, what=f" (a unit grid, eps = 1, min_samples = {min_samples})")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(1)
+def test_dbscan_every_column_is_a_coordinate(impl):
+    rng = np.random.default_rng(16)
+    points = _blobs(400, centres=4, columns=5, seed=16)
+    points[:, 3:] *= rng.choice([1.0, 30.0], size=(400, 1))  # far apart in the last columns only
+    _check_dbscan(impl, points, 1.5, 5, _scikit_learn_dbscan(points, 1.5, 5), " (5 columns)")
+    line = np.sort(rng.uniform(0, 40, 300))[:, None]
+    _check_dbscan(impl, line, 0.3, 3, _scikit_learn_dbscan(line, 0.3, 3), " (1 column)")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(1)
+def test_dbscan_far_from_the_origin(impl):
+    rng = np.random.default_rng(17)
+    points = np.vstack([rng.normal(c, 0.3, size=(120, 3)) for c in ([0, 0, 0], [2, 0, 0], [0, 2, 1])])
+    points += [525_000.0, 4_200_000.0, 35.0]  # UTM-like coordinates, in metres
+    _check_dbscan(impl, points, 0.25, 5, what=f" far from the origin ({EXPANDED.replace('c_j', 'q_j')})")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_dbscan_converts_float32_and_modifies_nothing(impl):
+    points = _blobs(300, centres=3, columns=3, seed=18).astype(np.float32)
+    labels, is_core = _unpack_dbscan(impl.dbscan(points, 0.8, 6), 300)
+    check_unmodified(impl, "dbscan")
+    _check_dbscan(impl, points.astype(np.float64), 0.8, 6, (labels, is_core), " (float32 points are converted)")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_dbscan_rejects_bad_arguments(impl):
+    points = _blobs(50, centres=2, columns=3, seed=19)
+    nan = points.copy()
+    nan[3, 1] = np.nan
+    cases = [
+        ({"points": points[:, 0]}, "points"),
+        ({"points": nan}, "points"),
+        ({"eps": 0.0}, "eps"),
+        ({"eps": -1.0}, "eps"),
+        ({"eps": np.inf}, "eps"),
+        ({"eps": np.nan}, "eps"),
+        ({"eps": True}, "eps"),
+        ({"min_samples": 0}, "min_samples"),
+        ({"min_samples": 2.5}, "min_samples"),
+        ({"min_samples": True}, "min_samples"),
+    ]
+    for change, name in cases:
+        arguments = {"points": points, "eps": 1.0, "min_samples": 5, **change}
+        with raises(ValueError, naming=name):
+            impl.dbscan(**arguments)
+    _unpack_dbscan(impl.dbscan(points, np.float32(1.0), np.int64(5)), 50)  # NumPy scalars are numbers

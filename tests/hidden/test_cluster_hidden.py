@@ -102,3 +102,77 @@ def test_kmeans_plusplus_hidden_draws(impl):
         check_array(result, "indices", shape=(k,), dtype="int64")
         if result.tolist() != _d2(points, k, seed):
             raise CheckFailed(f"the draws are wrong (rng = {seed})", rule="the draws are wrong")
+
+
+def _density_clusters(points, eps, min_samples):
+    """The contract's DBSCAN from its rules: cores by |N(p)| (itself included, s <= eps^2), clusters the
+    components of the cores numbered by their smallest core, a border the smallest label it touches."""
+    s = sum((points[:, j, None] - points[None, :, j]) ** 2 for j in range(points.shape[1]))
+    near = s <= eps * eps
+    is_core = near.sum(axis=1) >= min_samples
+    labels = np.full(len(points), -1, dtype=np.int64)
+    cluster = 0
+    for seed in np.flatnonzero(is_core):
+        if labels[seed] >= 0:
+            continue
+        labels[seed], frontier = cluster, [seed]
+        while frontier:
+            reached = np.flatnonzero(near[frontier.pop()] & is_core & (labels < 0))
+            labels[reached] = cluster
+            frontier.extend(reached.tolist())
+        cluster += 1
+    for p in np.flatnonzero(~is_core):
+        touched = labels[near[p] & is_core]
+        labels[p] = touched.min() if len(touched) else -1
+    return labels, is_core
+
+
+def _check_dbscan(impl, points, eps, min_samples, what):
+    result = impl.dbscan(points, eps, min_samples)
+    if not isinstance(result, tuple) or len(result) != 2:
+        raise CheckFailed("dbscan must return a tuple (labels, is_core)")
+    labels, is_core = result
+    check_array(labels, "labels", shape=(len(points),), dtype="int64")
+    check_array(is_core, "is_core", shape=(len(points),), dtype="bool")
+    expected_labels, expected_core = _density_clusters(points, eps, min_samples)
+    if not np.array_equal(is_core, expected_core):
+        raise CheckFailed(f"is_core is wrong {what}", rule="core points are those with |N(p)| >= min_samples")
+    if not np.array_equal(labels, expected_labels):
+        raise CheckFailed(f"the labels are wrong {what}", rule="the labels break a rule of the contract")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(3)
+def test_dbscan_hidden_random_clouds_with_duplicates(impl):
+    rng = np.random.default_rng(301)
+    for columns in (2, 3, 4):
+        centres = rng.uniform(-10, 10, size=(5, columns))
+        points = np.vstack([rng.normal(c, rng.uniform(0.3, 1.2), size=(120, columns)) for c in centres])
+        points = np.vstack([points, points[rng.choice(len(points), 150)], rng.uniform(-14, 14, size=(40, columns))])
+        points = points[rng.permutation(len(points))]
+        for eps, min_samples in ((0.7, 6), (1.2, 12), (0.35, 2)):
+            _check_dbscan(impl, points, eps, min_samples, "on a random cloud with duplicate points")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(2)
+def test_dbscan_hidden_borders_between_clusters(impl):
+    # Runs of points 0.25 apart along x, separated by gaps a lone point bridges: each bridge is a border
+    # point of the runs on both sides (eps = 0.5: the bridge has 3 points within eps, min_samples 4).
+    runs = [np.arange(5) * 0.25 + start for start in (0.0, 2.0, 4.0, 6.0)]
+    bridges = [1.5, 3.5, 5.5]
+    xs = np.concatenate([*runs, bridges])
+    for seed in (302, 303, 304):
+        order = np.random.default_rng(seed).permutation(len(xs))
+        points = np.column_stack([xs[order], np.zeros(len(xs))])
+        _check_dbscan(impl, points, 0.5, 4, "where border points touch two clusters")
+
+
+@pytest.mark.grades("dbscan")
+@pytest.mark.points(1)
+def test_dbscan_hidden_extreme_parameters_and_scales(impl):
+    rng = np.random.default_rng(305)
+    points = rng.normal(size=(200, 3))
+    _check_dbscan(impl, points, 0.5, 201, "when no point can be core")
+    _check_dbscan(impl, points, 100.0, 5, "when eps covers the whole cloud")
+    _check_dbscan(impl, points * 1e-6, 0.4e-6, 4, "at a micrometre scale")
