@@ -58,6 +58,10 @@ COMMON_MIN_STUDENTS = 3
 FAMILY_SHARE = 0.8
 DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
+# Each pair is compared twice, the higher share kept: as Python reads the files (what does nothing
+# removed: a padding between the lines of a copy is gone) and as submitted (whatever the normaliser
+# mistook for dead code is there). Normalising can then only raise a share, never hide a copy.
+VIEWS = {"as Python reads them": comparable, "as submitted": str}
 
 
 @dataclass(frozen=True)
@@ -66,7 +70,8 @@ class Pair:
 
     ``similarity`` is the larger of the two shares (the part of one file
     found in the other): a short file copied into a long one still scores
-    high.
+    high. ``view``: the texts compared (:data:`VIEWS`), the one of the
+    higher similarity.
     """
 
     module: str
@@ -77,23 +82,24 @@ class Pair:
     shared_tokens: int
     first_html: str
     second_html: str
+    view: str = next(iter(VIEWS))
 
     @property
     def similarity(self):
         return max(self.first_share, self.second_share)
 
 
-def _boilerplate_hashes(stubs):
+def _boilerplate_hashes(stubs, prepare):
     hashes = []
     for path in sorted(Path(stubs).glob("*.py")):
-        text = comparable(path.read_text(encoding="utf-8"))
+        text = prepare(path.read_text(encoding="utf-8"))
         hashes.extend(CodeFingerprint(str(path), NOISE_TOKENS, 1, fp=io.StringIO(text)).hashes)  # k-gram hashes
     return np.unique(np.array(hashes))
 
 
-def _fingerprints(module, texts, boilerplate):
+def _fingerprints(module, texts, boilerplate, prepare):
     return {
-        student: CodeFingerprint(f"{module}.py", NOISE_TOKENS, 1, boilerplate, fp=io.StringIO(comparable(text)))
+        student: CodeFingerprint(f"{module}.py", NOISE_TOKENS, 1, boilerplate, fp=io.StringIO(prepare(text)))
         for student, text in texts.items()
     }
 
@@ -119,11 +125,11 @@ def _families(hashes):
     return list(families.values())
 
 
-def _common_hashes(module, texts, boilerplate):
+def _common_hashes(module, texts, boilerplate, prepare):
     """The boilerplate plus every fingerprint too common in the class to mean copying, and those alone.
 
     A fingerprint counts once per family of near-copies (:func:`_families`)."""
-    hashes = {s: set(f.hashes) for s, f in _fingerprints(module, texts, boilerplate).items()}
+    hashes = {s: set(f.hashes) for s, f in _fingerprints(module, texts, boilerplate, prepare).items()}
     families = [family for family in _families(hashes) if any(hashes[s] for s in family)]
     counts = Counter(h for family in families for h in set().union(*(hashes[s] for s in family)))
     limit = max(COMMON_MIN_STUDENTS - 1, COMMON_SHARE * len(families))
@@ -186,6 +192,25 @@ def _student_modules(class_dir, into):
     return modules, skipped
 
 
+def _compared(module, first, second, view, fingerprints):
+    """The :class:`Pair` of two students' versions in one view, or None if they share no code."""
+    a, b = fingerprints[first], fingerprints[second]
+    tokens, (share_a, share_b), (slices_a, slices_b) = compare_files(a, b)
+    if tokens == 0:
+        return None
+    return Pair(
+        module,
+        first,
+        second,
+        float(share_a),
+        float(share_b),
+        int(tokens),
+        highlight_overlap(a.raw_code, slices_a, *HIGHLIGHT, escape_html=True)[0],
+        highlight_overlap(b.raw_code, slices_b, *HIGHLIGHT, escape_html=True)[0],
+        view,
+    )
+
+
 def submitted_by(folder, submitters=None):
     """A submission's label: its submitters' names (or emails, or SIDs) from Gradescope's metadata, then
     its folder in brackets (``Ann Lee (submission_4711)``); the folder alone without metadata."""
@@ -214,7 +239,7 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
         One line per entry, or module of an entry, that was not compared, with why, and one per module
         whose code common to most of the class was left out.
     """
-    boilerplate = _boilerplate_hashes(stubs)
+    boilerplate = {view: _boilerplate_hashes(stubs, prepare) for view, prepare in VIEWS.items()}
     work = tempfile.mkdtemp(prefix="grading-similarity-")
     try:
         modules, skipped = _student_modules(class_dir, work)
@@ -226,26 +251,17 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     pairs = []
     for module in EXERCISE_MODULES:
         texts = {student: files[module] for student, files in modules.items() if module in files}
-        left_out, common = _common_hashes(module, texts, boilerplate)
-        fingerprints = _fingerprints(module, texts, left_out)
-        skipped += [line for line in [_common_line(module, common)] if line]
-        for first, second in itertools.combinations(sorted(fingerprints), 2):
-            a, b = fingerprints[first], fingerprints[second]
-            tokens, (share_a, share_b), (slices_a, slices_b) = compare_files(a, b)
-            if tokens == 0:
-                continue
-            pairs.append(
-                Pair(
-                    module,
-                    first,
-                    second,
-                    float(share_a),
-                    float(share_b),
-                    int(tokens),
-                    highlight_overlap(a.raw_code, slices_a, *HIGHLIGHT, escape_html=True)[0],
-                    highlight_overlap(b.raw_code, slices_b, *HIGHLIGHT, escape_html=True)[0],
-                )
-            )
+        fingerprints = {}
+        for view, prepare in VIEWS.items():
+            left_out, common = _common_hashes(module, texts, boilerplate[view], prepare)
+            fingerprints[view] = _fingerprints(module, texts, left_out, prepare)
+            if prepare is comparable:
+                skipped += [line for line in [_common_line(module, common)] if line]
+        for first, second in itertools.combinations(sorted(texts), 2):
+            compared = [_compared(module, first, second, view, fingerprints[view]) for view in VIEWS]
+            compared = [pair for pair in compared if pair is not None]
+            if compared:
+                pairs.append(max(compared, key=lambda pair: pair.similarity))  # the first view on a tie
     pairs.sort(key=lambda pair: (-pair.similarity, pair.module, pair.first, pair.second))
     return pairs, skipped
 
@@ -291,7 +307,7 @@ def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
     )
     sections = "\n".join(
         f'<section class="pair" id="pair-{i}"><h2>{i}. {html.escape(p.module)}.py: '
-        f"{_text(p.first)} and {_text(p.second)} ({p.similarity:.0%})</h2>"
+        f"{_text(p.first)} and {_text(p.second)} ({p.similarity:.0%}, {html.escape(p.view)})</h2>"
         f'<div class="sides"><div><h3>{_text(p.first)} ({p.first_share:.0%} shared)</h3>'
         f"<pre>{_code(p.first_html)}</pre></div>"
         f"<div><h3>{_text(p.second)} ({p.second_share:.0%} shared)</h3>"
@@ -306,9 +322,10 @@ def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
 <p>{counted(len(pairs), "pair")} share{"s" if len(pairs) == 1 else ""} code beyond the stubs; {len(shown)} \
 reach{"es" if len(shown) == 1 else ""} {threshold:.0%} of a file and {"is" if len(shown) == 1 else "are"} shown.
 The share is the part of a student's file (stub text removed, names folded) that the other file holds too.
-Each file is compared, and shown, as Python reads it: comments and layout gone, and the statements that do
-nothing removed (<code>pass</code>, an expression without a call, a docstring, unreachable code, a store into a
-name nothing reads: <code>grading/instructors/dead_code.py</code>): read the submitted files themselves too.
+Each pair is compared twice, and the higher share kept and shown: as Python reads the files (comments and
+layout gone, and the statements that do nothing removed: <code>pass</code>, an expression without a call, a
+docstring, unreachable code, a store into a name nothing reads: <code>grading/instructors/dead_code.py</code>),
+and as submitted; each pair says which. Read the submitted files themselves too.
 A high share is a reason to read both files, not a verdict.</p>
 {f"<ul>{notes}</ul>" if notes else ""}
 <table><thead><tr><th>#</th><th>module</th><th>student</th><th>student</th>

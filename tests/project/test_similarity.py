@@ -370,3 +370,17 @@ def test_a_long_chain_of_functions_is_normalised_in_linear_time():
     started = time.process_time()
     comparable(chain)
     assert time.process_time() - started < 10
+
+
+def test_a_normaliser_that_drops_code_cannot_hide_a_copy(monkeypatch, tmp_path):
+    """Each pair is compared as Python reads it and as submitted, the higher share kept: a rule of the
+    normaliser that mistakes copied code for dead code (h48z found two) can lower no score."""
+    from grading.instructors import similarity
+
+    monkeypatch.setitem(similarity.VIEWS, "as Python reads them", lambda text: "x = 0\n")  # drops everything
+    for name, text in (("alice", ALICE), ("bob", ALICE), ("carol", CAROL), ("dave", DAVE)):
+        student(tmp_path, name, text)
+    pairs, _ = compare_class(tmp_path)
+    assert {pairs[0].first, pairs[0].second} == {"alice", "bob"} and pairs[0].similarity > 0.9, pairs[0]
+    assert pairs[0].view == "as submitted"
+    assert all(p.similarity < DISPLAY_THRESHOLD for p in pairs[1:])
