@@ -1,41 +1,13 @@
 """Re-seeds an empty cluster at the point farthest from its centre (scikit-learn's relocation), where
 the contract keeps an empty cluster's centre."""
 
-import numpy as np
-
 from solutions.cluster import *  # noqa: F401,F403
 from solutions.cluster import kmeans as _reference
+from tests.mutants import _plain_kmeans
 
 MISTAKE = "empty_cluster_relocated"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
 
 
-def _squared(x, c):
-    s = np.zeros((len(x), len(c)))
-    for j in range(x.shape[1]):
-        s += (x[:, j, None] - c[None, :, j]) ** 2
-    return s
-
-
 def kmeans(points, init_centers, max_iter=300):
     _reference(points, init_centers, max_iter)  # validation only
-    x = np.asarray(points, dtype=float)
-    c = np.array(init_centers, dtype=float)
-    inertia, previous = [], None
-    for t in range(1, max_iter + 1):
-        s = _squared(x, c)
-        labels = np.argmin(s, axis=1)
-        own = s[np.arange(len(x)), labels]
-        inertia.append(own.sum())
-        if previous is not None and np.array_equal(labels, previous):
-            break
-        counts = np.bincount(labels, minlength=len(c))
-        empty = np.flatnonzero(counts == 0)
-        far = np.argsort(-own, kind="stable")[: len(empty)]
-        for k in range(len(c)):
-            if counts[k]:
-                c[k] = x[labels == k].mean(axis=0)
-        c[empty] = x[far]
-        previous = labels
-        if t == max_iter:
-            labels = np.argmin(_squared(x, c), axis=1)
-    return labels.astype(np.int64), c, np.array(inertia), len(inertia)
+    return _plain_kmeans.kmeans(points, init_centers, max_iter, empty="relocate")
