@@ -415,9 +415,39 @@ def _kmeans_case(dataset, n, k=8, iterations=30):
     return Case("kmeans", f"k{k}", dataset, n, make, {"k": k, "iterations": iterations}, target)
 
 
+def _dbscan_case(dataset, n, min_samples=16):
+    """DBSCAN with ``eps`` the cloud's median distance to its 16th neighbour (about half the points
+    core), ``min_samples`` 16, against scikit-learn's (its k-d tree, one thread) and Open3D's (its
+    k-d tree, OpenMP; its strict ``< eps`` is another rule only at exact ties, none here)."""
+    eps = neighbourhood_radius(dataset, n, k=min_samples)
+
+    def make():
+        from sklearn.cluster import DBSCAN
+
+        from solutions.cluster import dbscan
+
+        xyz = cloud(dataset, n)
+        legacy = _legacy(xyz)
+        fit = DBSCAN(eps=eps, min_samples=min_samples)
+        return {
+            "reference": lambda: dbscan(xyz, eps, min_samples),
+            "scikit-learn": lambda: fit.fit(xyz),
+            "open3d": lambda: legacy.cluster_dbscan(eps, min_samples, print_progress=False),
+        }
+
+    target = (FASTEST_PEER, 1.0) if n >= 100_000 else None
+    return Case(
+        "dbscan", f"min{min_samples}", dataset, n, make, {"eps": "16-NN median", "min_samples": min_samples}, target
+    )
+
+
 def cluster_cases(sizes=SIZES, datasets=DATASETS):
-    """Lecture 3's cases: k-means on the cube and the scan."""
-    return [_kmeans_case(dataset, n) for dataset in datasets if dataset in ("cube", "scan") for n in sizes]
+    """Lecture 3's cases: k-means on the cube and the scan; DBSCAN on them up to 1e5 points
+    (scikit-learn's takes seconds a call beyond)."""
+    chosen = [dataset for dataset in datasets if dataset in ("cube", "scan")]
+    return [_kmeans_case(dataset, n) for dataset in chosen for n in sizes] + [
+        _dbscan_case(dataset, n) for dataset in chosen for n in sizes if n <= 100_000
+    ]
 
 
 NN_CASES = ("kdtree_build", "kdtree_knn", "kdtree_radius", "octree_radius")

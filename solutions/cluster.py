@@ -2,12 +2,11 @@
 stubs' (``pcl_course/cluster.py``: the contract)."""
 
 import numpy as np
-from scipy.sparse import coo_array
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from pcl_course import cluster as _contract
 from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_rng
+from solutions._fast.density import density_clusters
 from solutions._fast.lloyd import assign, cluster_sums
 
 __all__ = ["kmeans", "kmeans_plusplus", "dbscan"]
@@ -81,54 +80,19 @@ def kmeans_plusplus(points, n_clusters, rng=None):
     return np.array(chosen, dtype=np.int64)
 
 
-def _neighbour_pairs(points, eps):
-    """Every pair ``(i, j)``, i < j, with ``s(x_i, x_j) <= eps ** 2``: shape (P, 2), int64.
-
-    A k-d tree proposes the pairs within a slightly larger radius (its own
-    rounding never decides); the contract's ``s``, summed over the columns in
-    increasing order, decides which are neighbours.
-    """
+def _candidate_pairs(points, eps):
+    """Every pair ``(i, j)``, i < j, a k-d tree finds within a slightly larger radius than ``eps``
+    (its own rounding never decides: :func:`density_clusters` keeps those with the contract's
+    ``s <= eps ** 2``): shape (P, 2), int64."""
     if len(points) < 2:
         return np.empty((0, 2), dtype=np.int64)
-    reach = eps * (1 + 1e-9)
-    pairs = cKDTree(points).query_pairs(reach, output_type="ndarray").astype(np.int64).reshape(-1, 2)
-    s = np.zeros(len(pairs))
-    for j in range(points.shape[1]):
-        s += np.square(points[pairs[:, 0], j] - points[pairs[:, 1], j])
-    return pairs[s <= eps * eps]
-
-
-def _numbered_by_smallest_member(component, members, n):
-    """Each member's component renumbered 0, 1, ... by the component's smallest member index."""
-    smallest = np.full(component.max(initial=-1) + 1, n, dtype=np.int64)
-    np.minimum.at(smallest, component[members], members)
-    present = np.flatnonzero(smallest < n)
-    rank = np.empty(len(smallest), dtype=np.int64)
-    rank[present[np.argsort(smallest[present], kind="stable")]] = np.arange(len(present))
-    return rank[component[members]]
+    pairs = cKDTree(points).query_pairs(eps * (1 + 1e-9), output_type="ndarray")
+    return np.ascontiguousarray(pairs, dtype=np.int64).reshape(-1, 2)
 
 
 @_documented
 def dbscan(points, eps, min_samples):
-    points = as_points(points, min_columns=1)
+    points = np.ascontiguousarray(as_points(points, min_columns=1))
     eps = check_positive(eps, "eps")
     min_samples = check_integer(min_samples, "min_samples", low=1)
-    n = len(points)
-    pairs = _neighbour_pairs(points, eps)
-    is_core = 1 + np.bincount(pairs.ravel(), minlength=n) >= min_samples  # itself included
-    labels = np.full(n, -1, dtype=np.int64)
-    cores = np.flatnonzero(is_core)
-    if len(cores) == 0:
-        return labels, is_core
-    linked = pairs[is_core[pairs[:, 0]] & is_core[pairs[:, 1]]]
-    graph = coo_array((np.ones(len(linked)), (linked[:, 0], linked[:, 1])), shape=(n, n))
-    _, component = connected_components(graph, directed=False)
-    labels[cores] = _numbered_by_smallest_member(component, cores, n)
-    # A border point takes the smallest label among its core neighbours' clusters.
-    unset = np.iinfo(np.int64).max
-    border = np.full(n, unset, dtype=np.int64)
-    for core_end, other_end in ((0, 1), (1, 0)):
-        reach = is_core[pairs[:, core_end]] & ~is_core[pairs[:, other_end]]
-        np.minimum.at(border, pairs[reach, other_end], labels[pairs[reach, core_end]])
-    labels[border < unset] = border[border < unset]
-    return labels, is_core
+    return density_clusters(points, _candidate_pairs(points, eps), eps * eps, min_samples)

@@ -39,7 +39,7 @@ import solutions._fast
 from grading import REPO_ROOT
 from grading.instructors import tree_searches, trees
 from solutions import downsampling, filters, nn, normals
-from solutions._fast import lloyd
+from solutions._fast import density, lloyd
 from solutions._fast.grid import grid_radius_count
 from solutions._fast.knn import LEAF_SIZE, leaf_knn
 from solutions._fast.sorting import search_left, sort_pairs, sort_range
@@ -262,6 +262,24 @@ def test_lloyd_under_stress(name):
         expected = np.zeros_like(sums)
         np.add.at(expected, labels, points)  # in index order, as the kernel
         np.testing.assert_array_equal(sums, expected)
+
+
+@pytest.mark.parametrize("name", CLOUDS)
+def test_density_clusters_under_stress(name):
+    """DBSCAN's kernel from every pair (a superset of the neighbours, as a k-d tree's candidates)
+    against scikit-learn's DBSCAN, whose rules are the contract's."""
+    from sklearn.cluster import DBSCAN
+
+    points = np.ascontiguousarray(CLOUDS[name])
+    pairs = np.array([(i, j) for i in range(len(points)) for j in range(i + 1, len(points))], dtype=np.int64)
+    pairs = pairs.reshape(-1, 2)
+    spread = float(np.ptp(points, axis=0).max()) or 1.0
+    for eps in (spread / 20, spread / 5):
+        for min_samples in (1, 2, 5):
+            labels, is_core = density.density_clusters(points, pairs, eps * eps, min_samples)
+            fitted = DBSCAN(eps=eps, min_samples=min_samples).fit(points)
+            np.testing.assert_array_equal(labels, fitted.labels_, err_msg=f"eps={eps}, min_samples={min_samples}")
+            np.testing.assert_array_equal(np.flatnonzero(is_core), fitted.core_sample_indices_)
 
 
 @pytest.mark.parametrize("name, keys", list(_sort_cases()), ids=lambda v: v if isinstance(v, str) else "")
