@@ -46,6 +46,7 @@ ASSIGNMENTS = {
         "kmeans": "cluster",
         "kmeans_plusplus": "cluster",
         "dbscan": "cluster",
+        "euclidean_clusters": "cluster",
     },
 }
 GRADED_FUNCTIONS = {function: module for graded in ASSIGNMENTS.values() for function, module in graded.items()}

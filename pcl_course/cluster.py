@@ -1,10 +1,11 @@
-"""Exercises of lecture 3: clustering (k-means and its seeding, DBSCAN).
+"""Exercises of lecture 3: clustering (k-means and its seeding, DBSCAN, Euclidean clusters).
 
 The rules of this module (the course's contract, on top of the general rules):
 
 Points and distances
-    ``points`` is (N, D), D >= 1, N >= 1 (N >= 0 for :func:`dbscan`, whose
-    empty cloud has empty labels); every column is a coordinate.
+    ``points`` is (N, D), D >= 1, N >= 1 (N >= 0 for :func:`dbscan` and
+    :func:`euclidean_clusters`, whose empty cloud has empty labels); every
+    column is a coordinate.
     Everything is computed in float64 (float32 input is converted). The
     squared distance of a point p to a centre (or point) c is
     ``s = sum_j (p_j - c_j) ** 2`` over the columns, in increasing j (as in
@@ -27,9 +28,10 @@ Randomness
 
 Arguments
     Anything else than the documented shapes, non-finite values, a number of
-    clusters outside its range, a ``max_iter`` or ``min_samples`` below 1 or
-    an ``eps`` that is not a positive finite number is a ``ValueError``
-    naming the argument. Inputs are never modified.
+    clusters or a size outside its range, a ``max_iter`` or ``min_samples``
+    below 1 or an ``eps`` or ``tolerance`` that is not a positive finite
+    number is a ``ValueError`` naming the argument. Inputs are never
+    modified.
 
 Forbidden here
     scikit-learn and Open3D (forbidden everywhere), ``scipy.cluster``,
@@ -43,7 +45,7 @@ import numpy as np  # noqa: F401
 
 from pcl_course.validation import as_array, as_points, check_integer, check_rng  # noqa: F401
 
-__all__ = ["kmeans", "kmeans_plusplus", "dbscan"]
+__all__ = ["kmeans", "kmeans_plusplus", "dbscan", "euclidean_clusters"]
 
 
 def kmeans(points, init_centers, max_iter=300):
@@ -190,3 +192,46 @@ def dbscan(points, eps, min_samples):
         number; ``min_samples`` not an integer >= 1.
     """
     raise NotImplementedError("dbscan: not implemented yet")
+
+
+def euclidean_clusters(points, tolerance, min_size=1, max_size=None):
+    """Euclidean cluster extraction (PCL's ``EuclideanClusterExtraction``).
+
+    1. Two points p and q are **linked** when ``s(p, q) <= tolerance ** 2``
+       (inclusive: points exactly ``tolerance`` apart are linked).
+    2. The clusters are the connected components of the links (a point
+       alone is a component of size 1).
+    3. A component of fewer than ``min_size`` points, or of more than
+       ``max_size`` points, is dropped: its points are labelled -1.
+    4. The kept clusters are numbered 0, 1, ... by **decreasing size**;
+       clusters of equal size by their smallest point index.
+
+    This is :func:`dbscan` with ``min_samples = 1`` (every point core),
+    size filters and another numbering (PCL's: largest first).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+        The points, N >= 0, D >= 1.
+    tolerance : float
+        The largest distance between linked points, in the points' units;
+        positive and finite.
+    min_size : int, default 1
+        The smallest cluster kept, >= 1.
+    max_size : int or None, default None
+        The largest cluster kept (None: no limit), >= ``min_size``.
+
+    Returns
+    -------
+    labels : ndarray of int64, shape (N,)
+        Each point's cluster (numbered as in 4.), or -1 for a point of a
+        dropped component.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points`` (shape, non-finite); ``tolerance`` not a positive
+        finite number; ``min_size`` not an integer >= 1; ``max_size``
+        neither None nor an integer >= ``min_size``.
+    """
+    raise NotImplementedError("euclidean_clusters: not implemented yet")

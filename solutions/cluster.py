@@ -1,5 +1,5 @@
-"""Reference: k-means (Lloyd's algorithm), the k-means++ seeding and DBSCAN. The docstrings are the
-stubs' (``pcl_course/cluster.py``: the contract)."""
+"""Reference: k-means (Lloyd's algorithm), the k-means++ seeding, DBSCAN and Euclidean cluster
+extraction. The docstrings are the stubs' (``pcl_course/cluster.py``: the contract)."""
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -9,7 +9,7 @@ from pcl_course.validation import as_array, as_points, check_integer, check_posi
 from solutions._fast.density import density_clusters
 from solutions._fast.lloyd import assign, cluster_sums
 
-__all__ = ["kmeans", "kmeans_plusplus", "dbscan"]
+__all__ = ["kmeans", "kmeans_plusplus", "dbscan", "euclidean_clusters"]
 
 
 def _documented(function):
@@ -96,3 +96,20 @@ def dbscan(points, eps, min_samples):
     eps = check_positive(eps, "eps")
     min_samples = check_integer(min_samples, "min_samples", low=1)
     return density_clusters(points, _candidate_pairs(points, eps), eps * eps, min_samples)
+
+
+@_documented
+def euclidean_clusters(points, tolerance, min_size=1, max_size=None):
+    points = np.ascontiguousarray(as_points(points, min_columns=1))
+    tolerance = check_positive(tolerance, "tolerance")
+    min_size = check_integer(min_size, "min_size", low=1)
+    if max_size is not None:
+        max_size = check_integer(max_size, "max_size", low=min_size)
+    # Every point core: the components, numbered by their smallest index.
+    components, _ = density_clusters(points, _candidate_pairs(points, tolerance), tolerance * tolerance, 1)
+    sizes = np.bincount(components, minlength=0)
+    kept = (sizes >= min_size) & (sizes <= (len(points) if max_size is None else max_size))
+    order = np.flatnonzero(kept)[np.argsort(-sizes[kept], kind="stable")]  # largest first, then smallest index
+    renumbered = np.full(len(sizes), -1, dtype=np.int64)
+    renumbered[order] = np.arange(len(order))
+    return renumbered[components]

@@ -729,3 +729,155 @@ def test_dbscan_rejects_bad_arguments(impl):
         with raises(ValueError, naming=name):
             impl.dbscan(**arguments)
     _unpack_dbscan(impl.dbscan(points, np.float32(1.0), np.int64(5)), 50)  # NumPy scalars are numbers
+
+
+# --- euclidean_clusters ----------------------------------------------------------------
+
+
+def linked_components(points, tolerance, min_size=1, max_size=None):
+    """The contract's answer, from its rules: SciPy's connected components of the links s <= tolerance^2,
+    components outside the sizes dropped, the rest numbered by decreasing size, then smallest index."""
+    from scipy.sparse import csr_array
+    from scipy.sparse.csgraph import connected_components
+
+    points = np.asarray(points, dtype=float)
+    s = sum((points[:, j, None] - points[None, :, j]) ** 2 for j in range(points.shape[1]))
+    _, component = connected_components(csr_array(s <= tolerance * tolerance), directed=False)
+    labels = np.full(len(points), -1, dtype=np.int64)
+    members = [np.flatnonzero(component == c) for c in range(component.max(initial=-1) + 1)]
+    kept = [m for m in members if min_size <= len(m) <= (len(points) if max_size is None else max_size)]
+    for label, m in enumerate(sorted(kept, key=lambda m: (-len(m), m[0]))):
+        labels[m] = label
+    return labels
+
+
+def _check_components(impl, points, tolerance, min_size=1, max_size=None, expected=None, what=""):
+    labels = impl.euclidean_clusters(points, tolerance, min_size, max_size)
+    check_array(labels, "labels", shape=(len(points),), dtype="int64")
+    want = linked_components(points, tolerance, min_size, max_size) if expected is None else np.asarray(expected)
+    if np.array_equal(labels, want):
+        return labels
+    p = int(np.argmax(labels != want))
+    if want[p] < 0:
+        size = int(np.sum(linked_components(points, tolerance) == linked_components(points, tolerance)[p]))
+        raise CheckFailed(
+            f"point {p} lies in a component of {size} points, outside the sizes {min_size}..{max_size}: it is -1, "
+            f"yours labels it {labels[p]}{what}",
+            rule="a component outside the sizes is dropped (-1)",
+        )
+    sizes = np.bincount(want[want >= 0])
+    raise CheckFailed(
+        f"point {p} has label {labels[p]}, expected {want[p]}{what}: the clusters are the connected components of "
+        "the links s <= tolerance ** 2 (inclusive), numbered by decreasing size, equal sizes by their smallest "
+        f"index (here the sizes are {as_list(sizes, 6)})",
+        rule="the clusters are the components, largest first",
+    )
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_euclidean_clusters_returns_int64_labels(impl):
+    points = _blobs(200, centres=3, columns=3, seed=21)
+    check_array(impl.euclidean_clusters(points, 0.8), "labels", shape=(200,), dtype="int64")
+    check_array(impl.euclidean_clusters(np.empty((0, 3)), 0.8), "labels", shape=(0,), dtype="int64")
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(2)
+def test_euclidean_clusters_on_a_line_worked_by_hand(impl):
+    # Runs of points 1 apart with tolerance 1 (exactly the tolerance: linked): sizes 3, 2 and 1.
+    points = np.array([[0.0], [1.0], [2.0], [5.0], [6.0], [9.0]])
+    _check_components(impl, points, 1.0, expected=[0, 0, 0, 1, 1, 2], what=" (a line worked by hand)")
+    _check_components(impl, points, 1.0, 2, expected=[0, 0, 0, 1, 1, -1], what=" (min_size = 2)")
+    _check_components(impl, points, 1.0, 1, 2, expected=[-1, -1, -1, 0, 0, 1], what=" (max_size = 2)")
+    _check_components(impl, points, 3.0, expected=[0] * 6, what=" (tolerance 3: gaps of 3 linked)")
+    _check_components(impl, points, 3.0, 1, 5, expected=[-1] * 6, what=" (tolerance 3, max_size = 5)")
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(2)
+def test_euclidean_clusters_numbers_the_largest_first(impl):
+    # The first points form the smallest cluster; two clusters of equal size follow in reverse order.
+    grid = np.stack(np.meshgrid(np.arange(3.0), np.arange(3.0)), -1).reshape(-1, 2)  # 9 points
+    points = np.vstack([[[-10.0, 0.0]], [[-10.0, 1.0]], grid + [20.0, 0.0], grid, grid[:4] + [0.0, 10.0]])
+    _check_components(impl, points, 1.0, what=" (clusters of sizes 2, 9, 9 and 4)")
+    shuffled = _blobs(600, centres=7, columns=3, seed=22)[np.random.default_rng(22).permutation(600)]
+    _check_components(impl, shuffled, 0.5, 3, what=" (shuffled blobs)")
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(2)
+def test_euclidean_clusters_on_the_scan_without_its_ground(impl):
+    from pcl_course.datasets import LIDAR_CLASSES, simulate_lidar_scan
+
+    scan = simulate_lidar_scan(seed=6, n_azimuth=900)
+    above = scan.points[(scan.labels != LIDAR_CLASSES.index("ground")) & (np.linalg.norm(scan.points, axis=1) < 30)]
+    points = above[np.random.default_rng(6).choice(len(above), min(3000, len(above)), replace=False)]
+    _check_components(impl, points, 0.5, 20, what=" (the scan, tolerance 0.5 m, at least 20 points)")
+    _check_components(impl, points, 0.8, 5, 400, what=" (the scan, tolerance 0.8 m, 5 to 400 points)")
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(1)
+def test_euclidean_clusters_is_dbscan_with_one_sample(impl):
+    points = _blobs(500, centres=5, columns=2, seed=23)
+    labels = impl.euclidean_clusters(points, 0.3)
+    dbscan_labels, _ = _scikit_learn_dbscan(points, 0.3, 1)
+    # The same partition (scikit-learn numbers by smallest index, the contract by size).
+    pairs = {(int(a), int(b)) for a, b in zip(labels, dbscan_labels)}
+    if len(pairs) != len(set(dbscan_labels)) or len({a for a, _ in pairs}) != len(pairs):
+        raise CheckFailed(
+            "your clusters are not the connected components of the links s <= tolerance ** 2 (scikit-learn's "
+            "DBSCAN with min_samples = 1 finds other groups)",
+            rule="the clusters are the components",
+        )
+    _check_components(impl, points, 0.3, what=" (blobs)")
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(1)
+def test_euclidean_clusters_every_column_and_far_from_the_origin(impl):
+    rng = np.random.default_rng(24)
+    points = _blobs(300, centres=4, columns=5, seed=24)
+    points[:, 3:] *= rng.choice([1.0, 30.0], size=(300, 1))
+    _check_components(impl, points, 1.0, what=" (5 columns)")
+    far = np.vstack([rng.normal(c, 0.2, size=(100, 3)) for c in ([0, 0, 0], [2, 0, 0])]) + [525_000.0, 4.2e6, 35.0]
+    _check_components(impl, far, 0.15, 2, what=f" far from the origin ({EXPANDED.replace('c_j', 'q_j')})")
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_euclidean_clusters_converts_float32_and_modifies_nothing(impl):
+    points = _blobs(300, centres=3, columns=3, seed=25).astype(np.float32)
+    labels = impl.euclidean_clusters(points, 0.6, 2)
+    check_unmodified(impl, "euclidean_clusters")
+    _check_components(impl, points.astype(np.float64), 0.6, 2, expected=labels, what=" (float32 is converted)")
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_euclidean_clusters_rejects_bad_arguments(impl):
+    points = _blobs(50, centres=2, columns=3, seed=26)
+    nan = points.copy()
+    nan[3, 1] = np.nan
+    cases = [
+        ({"points": points[:, 0]}, "points"),
+        ({"points": nan}, "points"),
+        ({"tolerance": 0.0}, "tolerance"),
+        ({"tolerance": np.inf}, "tolerance"),
+        ({"tolerance": True}, "tolerance"),
+        ({"min_size": 0}, "min_size"),
+        ({"min_size": 1.5}, "min_size"),
+        ({"max_size": 0}, "max_size"),
+        ({"min_size": 5, "max_size": 4}, "max_size"),
+        ({"max_size": 2.5}, "max_size"),
+        ({"max_size": True}, "max_size"),
+    ]
+    for change, name in cases:
+        arguments = {"points": points, "tolerance": 1.0, "min_size": 1, "max_size": None, **change}
+        with raises(ValueError, naming=name):
+            impl.euclidean_clusters(**arguments)
+    check_array(impl.euclidean_clusters(points, 1.0, np.int64(2), np.int64(50)), "labels", shape=(50,), dtype="int64")

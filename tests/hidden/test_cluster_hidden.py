@@ -176,3 +176,45 @@ def test_dbscan_hidden_extreme_parameters_and_scales(impl):
     _check_dbscan(impl, points, 0.5, 201, "when no point can be core")
     _check_dbscan(impl, points, 100.0, 5, "when eps covers the whole cloud")
     _check_dbscan(impl, points * 1e-6, 0.4e-6, 4, "at a micrometre scale")
+
+
+def _components(points, tolerance, min_size, max_size):
+    """The contract's Euclidean clusters: components of s <= tolerance^2, sizes filtered, largest first."""
+    s = sum((points[:, j, None] - points[None, :, j]) ** 2 for j in range(points.shape[1]))
+    linked = s <= tolerance * tolerance
+    component = np.full(len(points), -1)
+    for seed in range(len(points)):
+        if component[seed] >= 0:
+            continue
+        component[seed], frontier = seed, [seed]
+        while frontier:
+            reached = np.flatnonzero(linked[frontier.pop()] & (component < 0))
+            component[reached] = seed
+            frontier.extend(reached.tolist())
+    roots, sizes = np.unique(component, return_counts=True)
+    largest = max_size if max_size is not None else len(points)
+    kept = sorted((-size, root) for root, size in zip(roots, sizes) if min_size <= size <= largest)
+    labels = np.full(len(points), -1, dtype=np.int64)
+    for label, (_, root) in enumerate(kept):
+        labels[component == root] = label
+    return labels
+
+
+@pytest.mark.grades("euclidean_clusters")
+@pytest.mark.points(2)
+def test_euclidean_clusters_hidden_random_clouds(impl):
+    rng = np.random.default_rng(311)
+    for columns in (2, 3):
+        centres = rng.uniform(-8, 8, size=(6, columns))
+        sizes = rng.integers(10, 120, size=len(centres))
+        points = np.vstack([rng.normal(c, rng.uniform(0.2, 0.8), size=(n, columns)) for c, n in zip(centres, sizes)])
+        points = np.vstack([points, points[rng.choice(len(points), 60)], rng.uniform(-10, 10, size=(30, columns))])
+        points = points[rng.permutation(len(points))]
+        for tolerance, min_size, max_size in ((0.5, 1, None), (0.8, 5, None), (0.6, 3, 100), (1.5, 10, 250)):
+            labels = impl.euclidean_clusters(points, tolerance, min_size, max_size)
+            check_array(labels, "labels", shape=(len(points),), dtype="int64")
+            if not np.array_equal(labels, _components(points, tolerance, min_size, max_size)):
+                raise CheckFailed(
+                    "the labels are wrong on a random cloud with duplicate points",
+                    rule="the labels break a rule of the contract",
+                )
