@@ -11,18 +11,23 @@ gone. What it drops:
 
 - ``pass``; an expression statement whose evaluation has no effect
   (:func:`_pure`: constants, names, operators, attributes, subscripts,
-  displays of them; a docstring too; calls of pure functions,
+  displays of them, ``a if t else b``, f-strings, comprehensions over
+  literals; a docstring too; calls of pure functions,
   :func:`_pure_callees`: ``abs(0)``, ``len(points)``, ``np.sqrt(x)``
-  without ``out=``, a module function that only returns a pure value);
+  without ``out=``, a module function that only returns a pure value, a
+  lambda called at once, an array method that computes a value,
+  ``points.sum()``, :data:`PURE_METHODS`);
   ``assert`` on a true constant; ``global`` and ``nonlocal``;
 - a block under a constant test: ``if 0:`` (its ``else`` kept), ``if 1:``
   (its body kept), ``while 0:``, ``for _ in ():`` (their ``else`` kept); an
   ``if``, ``while``, ``for`` or ``try`` left with nothing to do (:func:`_does_nothing`);
 - what follows a ``return``, ``raise``, ``break`` or ``continue`` in its block;
 - a store into names the module never reads, or reads only to store into
-  themselves (``_ = 0``, ``x = x``, ``k = k + 1`` and nowhere else); a store
-  of a value with an effect keeps the value, as a statement
-  (``heappush(heap, item)`` of ``_ = heappush(heap, item)``);
+  themselves or into other such names, to a fixed point (``_ = 0``,
+  ``x = x``, ``k = k + 1``, a chain ``_b = _a``, ``_c = _b``, ... of any
+  length; a walrus ``(x := 0)`` as a statement); a store of a value with an
+  effect keeps the value, as a statement (``heappush(heap, item)`` of
+  ``_ = heappush(heap, item)``);
 - ``del`` of such names; an import, or a function or class defined inside
   another, whose names are never read (the module's own functions are its
   interface: kept).
@@ -55,6 +60,11 @@ PURE_BUILTINS = frozenset(
 )
 # Builtins that consume an iterable argument (an iterator is used up): pure on displays and constants only.
 CONSUMING_BUILTINS = frozenset("all any dict frozenset list max min set sorted sum tuple".split())
+# Array methods that return a new value and change nothing (``out=`` makes some write: then not pure).
+PURE_METHODS = frozenset(
+    "all any argmax argmin astype copy cumsum dot max mean min prod ravel reshape round std sum tolist "
+    "transpose var".split()
+)
 # NumPy functions that return a new value (``out=`` makes any of them write: then not pure).
 PURE_NUMPY = frozenset(
     "abs absolute all amax amin any arange argmax argmin argsort array asarray ceil clip concatenate "
@@ -80,6 +90,16 @@ def _pure(node, callees=frozenset()):
         return _pure(node.left, callees) and all(_pure(c, callees) for c in node.comparators)
     if isinstance(node, ast.Tuple | ast.List | ast.Set):
         return all(_pure(element, callees) for element in node.elts)
+    if isinstance(node, ast.Dict):
+        return all(_pure(part, callees) for part in (*node.keys, *node.values))
+    if isinstance(node, ast.IfExp):
+        return _pure(node.test, callees) and _pure(node.body, callees) and _pure(node.orelse, callees)
+    if isinstance(node, ast.JoinedStr):
+        return all(_pure(value, callees) for value in node.values)
+    if isinstance(node, ast.FormattedValue):
+        return _pure(node.value, callees) and _pure(node.format_spec, callees)
+    if isinstance(node, ast.ListComp | ast.SetComp | ast.GeneratorExp | ast.DictComp):
+        return _pure_comprehension(node, callees)
     if isinstance(node, ast.Attribute):
         return _pure(node.value, callees)
     if isinstance(node, ast.Subscript):
@@ -89,6 +109,16 @@ def _pure(node, callees=frozenset()):
     if isinstance(node, ast.Call):
         return _pure_call(node, callees)
     return False
+
+
+def _pure_comprehension(node, callees):
+    """A comprehension over literals (an iterator could be used up) whose parts are pure."""
+    parts = [node.key, node.value] if isinstance(node, ast.DictComp) else [node.elt]
+    for generator in node.generators:
+        if generator.is_async or not _literal(generator.iter) or not _stored_names([generator.target]):
+            return False
+        parts += generator.ifs
+    return all(_pure(part, callees) for part in parts)
 
 
 def _callee(func):
@@ -110,7 +140,15 @@ def _literal(node):
 
 
 def _pure_call(node, callees):
-    name = _callee(node.func)
+    if isinstance(node.func, ast.Lambda):  # (lambda: 2)(): the lambda's body is the call
+        callees = callees | {"<lambda>"}
+        name = "<lambda>" if _pure(node.func.body, callees) else None
+    elif isinstance(node.func, ast.Attribute) and node.func.attr in PURE_METHODS:
+        # points.sum(): a method that computes a value, unless the module defines one of that name.
+        name = "<method>" if f".{node.func.attr}" in callees and _pure(node.func.value, callees) else None
+        callees = callees | {"<method>"}
+    else:
+        name = _callee(node.func)
     if name is None or any(isinstance(a, ast.Starred) for a in node.args):
         return False
     keywords = {keyword.arg for keyword in node.keywords}
@@ -171,6 +209,7 @@ def _pure_callees(tree):
     to a fixed point: one may call another)."""
     bound = _bound_names(tree)
     callees = {name for name in PURE_BUILTINS | CONSUMING_BUILTINS | {"print"} if name not in bound}
+    callees |= {f".{name}" for name in PURE_METHODS if name not in bound}  # no method of that name defined
     imported = [
         (alias.asname or alias.name.split(".")[0], alias.name if isinstance(node, ast.Import) else None)
         for node in ast.walk(tree)
@@ -221,19 +260,40 @@ def _stored_names(targets):
     return names
 
 
-def _read_names(tree):
-    """The names ``tree`` loads anywhere, but in a store's own value into that same name."""
-    own = set()  # the Name nodes a store reads of its own targets: k = k + 1
+def _read_names(tree, callees=frozenset()):
+    """The names ``tree`` reads, but in the values of dead stores: a store into plain names with a
+    pure value reads its value's names only if one of its own names is read, to a fixed point (a
+    chain of dead stores of any length, ``_b = _a``, ``_c = _b``, ..., reads nothing; so does
+    ``k = k + 1``). A walrus ``(x := v)`` stores into ``x`` the same way."""
+    load_ids, stores = set(), []  # the Name loads in dead-able stores' values; (targets, their loads)
     for node in ast.walk(tree):
         if isinstance(node, _STORES) and node.value is not None:
             targets = node.targets if isinstance(node, ast.Assign) else [node.target]
-            stored = _stored_names(targets) or set()
-            own |= {id(n) for n in ast.walk(node.value) if isinstance(n, ast.Name) and n.id in stored}
-    return {
+        elif isinstance(node, ast.NamedExpr):
+            targets = [node.target]
+        else:
+            continue
+        names = _stored_names(targets)
+        if names and _pure(node.value, callees):
+            loads = [n for n in ast.walk(node.value) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)]
+            load_ids |= {id(n) for n in loads}
+            stores.append((names, {n.id for n in loads}))
+    read = {
         node.id
         for node in ast.walk(tree)
-        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load) and id(node) not in own
+        if isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load) and id(node) not in load_ids
     }
+    feeding = {}  # name -> the names read by the stores into it
+    for names, loads in stores:
+        for name in names:
+            feeding.setdefault(name, set()).update(loads)
+    pending = list(read)
+    while pending:
+        for name in feeding.pop(pending.pop(), ()):
+            if name not in read:
+                read.add(name)
+                pending.append(name)
+    return read
 
 
 def _constant_truth(test):
@@ -295,6 +355,8 @@ class _DeadCode(ast.NodeTransformer):
             targets, value = [statement.target], statement.value
         elif isinstance(statement, ast.Delete):
             return None if self._unread(_stored_names(statement.targets)) else statement
+        elif isinstance(statement, ast.Expr) and isinstance(statement.value, ast.NamedExpr):
+            targets, value = [statement.value.target], statement.value.value  # (x := v) as a statement
         else:
             return statement
         if not self._unread(_stored_names(targets)):
@@ -375,10 +437,11 @@ def comparable(text):
         tree = ast.parse(text)
         written = None
         for _ in range(DEAD_CODE_ROUNDS):
-            read = _read_names(tree)
+            callees = _pure_callees(tree)
+            read = _read_names(tree, callees)
             if _reads_names_dynamically(tree):
                 read |= _bound_names(tree)
-            tree = _DeadCode(read, _pure_callees(tree)).visit(tree)
+            tree = _DeadCode(read, callees).visit(tree)
             previous, written = written, ast.unparse(tree)
             if written == previous:
                 break
