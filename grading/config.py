@@ -45,6 +45,7 @@ ASSIGNMENTS = {
     "lecture3": {
         "kmeans": "cluster",
         "kmeans_plusplus": "cluster",
+        "gmm_em": "cluster",
         "dbscan": "cluster",
         "euclidean_clusters": "cluster",
     },

@@ -1,4 +1,5 @@
-"""Exercises of lecture 3: clustering (k-means and its seeding, DBSCAN, Euclidean clusters).
+"""Exercises of lecture 3: clustering (k-means and its seeding, Gaussian mixtures by EM, DBSCAN,
+Euclidean clusters).
 
 The rules of this module (the course's contract, on top of the general rules):
 
@@ -20,7 +21,8 @@ Ties
     the lowest index**.
 
 Randomness
-    :func:`kmeans` is deterministic: it starts from the centres it is given.
+    :func:`kmeans` and :func:`gmm_em` are deterministic: they start from
+    the centres or parameters they are given.
     Only :func:`kmeans_plusplus` draws, from ``rng`` (``None``, an int seed
     or a ``numpy.random.Generator``, as ``np.random.default_rng(rng)``),
     exactly the draws its docstring lists, in that order: the same seed gives
@@ -45,7 +47,7 @@ import numpy as np  # noqa: F401
 
 from pcl_course.validation import as_array, as_points, check_integer, check_rng  # noqa: F401
 
-__all__ = ["kmeans", "kmeans_plusplus", "dbscan", "euclidean_clusters"]
+__all__ = ["kmeans", "kmeans_plusplus", "gmm_em", "dbscan", "euclidean_clusters"]
 
 
 def kmeans(points, init_centers, max_iter=300):
@@ -142,6 +144,82 @@ def kmeans_plusplus(points, n_clusters, rng=None):
         ``1 ..`` the number of distinct points; a bad ``rng``.
     """
     raise NotImplementedError("kmeans_plusplus: not implemented yet")
+
+
+def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
+    """A Gaussian mixture fitted by expectation-maximisation, from the given parameters.
+
+    The mixture has K components, each with a weight ``pi_k``, a mean
+    ``mu_k`` and a full covariance ``Sigma_k``. Iteration t = 1, 2, ...:
+
+    1. **E-step**, with the current parameters, in the log domain:
+       ``log rho[n, k] = log pi_k + log N(x_n; mu_k, Sigma_k)``, where
+       ``log N(x; mu, Sigma) = -(D log(2 pi) + |L^-1 (x - mu)|^2) / 2 - sum_j
+       log L_jj`` with L the lower Cholesky factor of Sigma;
+       ``l[n] = logsumexp_k log rho[n, k]`` and
+       ``log r[n, k] = log rho[n, k] - l[n]`` (the responsibilities).
+       Record ``lower_bounds[t - 1] = mean_n l[n]``, the average
+       log-likelihood of the parameters the step started from.
+    2. **M-step**: ``N_k = sum_n r[n, k] + 10 eps`` (eps the float64
+       machine epsilon, ``np.finfo(float).eps``: an empty component's
+       mean stays finite), ``mu_k = sum_n r[n, k] x_n / N_k``,
+       ``Sigma_k = sum_n r[n, k] (x_n - mu_k)(x_n - mu_k)^T / N_k +
+       reg_covar I`` and ``pi_k = N_k / sum_j N_j``.
+    3. If t > 1 and ``|lower_bounds[t - 1] - lower_bounds[t - 2]| < tol``,
+       **stop**: ``n_iter = t``. Otherwise go on, up to ``max_iter``
+       iterations (then ``n_iter = max_iter``).
+
+    The returned responsibilities are those of the returned parameters: one
+    more E-step after the last M-step (not an iteration: nothing is
+    recorded). These are scikit-learn's ``GaussianMixture(covariance_type=
+    "full")`` rules, started from ``weights_init``, ``means_init`` and the
+    covariances' inverses as ``precisions_init``.
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+        The points, N >= 1, D >= 1.
+    weights : array_like, shape (K,)
+        The initial weights, positive, summing to 1 (within 1e-8), K >= 1.
+    means : array_like, shape (K, D)
+        The initial means.
+    covariances : array_like, shape (K, D, D)
+        The initial covariances, each symmetric (within 1e-10 of its
+        largest entry) and positive definite.
+    max_iter : int, default 100
+        Largest number of iterations, >= 1.
+    tol : float, default 1e-3
+        The change of the average log-likelihood below which EM stops,
+        >= 0 (0: run ``max_iter`` iterations unless it stops changing).
+    reg_covar : float, default 1e-6
+        Added to the diagonal of every covariance the M-step computes
+        (keeps a component on too few points positive definite), >= 0.
+
+    Returns
+    -------
+    weights : ndarray of float64, shape (K,)
+    means : ndarray of float64, shape (K, D)
+    covariances : ndarray of float64, shape (K, D, D)
+        The final parameters.
+    responsibilities : ndarray of float64, shape (N, K)
+        ``r[n, k]`` of the final parameters; each row sums to 1. A point's
+        cluster is its row's argmax (ties to the lowest index).
+    lower_bounds : ndarray of float64, shape (n_iter,)
+        The average log-likelihood recorded at each iteration's E-step; it
+        never decreases (in exact arithmetic, for ``reg_covar = 0``).
+    n_iter : int
+        The number of iterations run, ``1 <= n_iter <= max_iter``.
+
+    Raises
+    ------
+    ValueError
+        Bad ``points``; ``weights``, ``means`` or ``covariances`` of the
+        wrong shape, not finite, weights not positive or not summing to 1,
+        a covariance not symmetric or not positive definite; ``max_iter``
+        not an integer >= 1; ``tol`` or ``reg_covar`` not a finite number
+        >= 0.
+    """
+    raise NotImplementedError("gmm_em: not implemented yet")
 
 
 def dbscan(points, eps, min_samples):

@@ -1,15 +1,17 @@
-"""Reference: k-means (Lloyd's algorithm), the k-means++ seeding, DBSCAN and Euclidean cluster
-extraction. The docstrings are the stubs' (``pcl_course/cluster.py``: the contract)."""
+"""Reference: k-means (Lloyd's algorithm), the k-means++ seeding, Gaussian mixtures by EM, DBSCAN and
+Euclidean cluster extraction. The docstrings are the stubs' (``pcl_course/cluster.py``: the contract)."""
 
 import numpy as np
+from scipy import linalg
 from scipy.spatial import cKDTree
+from scipy.special import logsumexp
 
 from pcl_course import cluster as _contract
-from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_rng
+from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_rng, check_scalar
 from solutions._fast.density import density_clusters
 from solutions._fast.lloyd import assign, cluster_sums
 
-__all__ = ["kmeans", "kmeans_plusplus", "dbscan", "euclidean_clusters"]
+__all__ = ["kmeans", "kmeans_plusplus", "gmm_em", "dbscan", "euclidean_clusters"]
 
 
 def _documented(function):
@@ -78,6 +80,79 @@ def kmeans_plusplus(points, n_clusters, rng=None):
         chosen.append(int(np.searchsorted(cumulative, rng.random() * cumulative[-1], side="right")))
         nearest = np.minimum(nearest, _squared_distances(points, points[chosen[-1:]])[:, 0])
     return np.array(chosen, dtype=np.int64)
+
+
+def _mixture(weights, means, covariances, width):
+    """The initial parameters as float64 copies, checked as the contract says (ValueError naming each)."""
+    weights = as_array(weights, "weights", ndim=1, allow_empty=False).copy()
+    if np.any(weights <= 0) or abs(weights.sum() - 1.0) > 1e-8:
+        raise ValueError(f"weights must be positive and sum to 1, got sum {weights.sum()!r}")
+    k = len(weights)
+    means = as_array(means, "means", ndim=2).copy()
+    if means.shape != (k, width):
+        raise ValueError(f"means must have shape ({k}, {width}) (K weights, the width of points), got {means.shape}")
+    covariances = as_array(covariances, "covariances", ndim=3).copy()
+    if covariances.shape != (k, width, width):
+        raise ValueError(f"covariances must have shape ({k}, {width}, {width}), got {covariances.shape}")
+    for c in covariances:
+        if np.abs(c - c.T).max() > 1e-10 * np.abs(c).max():
+            raise ValueError("covariances must be symmetric")
+        try:
+            linalg.cholesky(c, lower=True)
+        except linalg.LinAlgError:
+            raise ValueError("covariances must be positive definite") from None
+    return weights, means, covariances
+
+
+def _precision_factors(covariances):
+    """Each covariance's precision Cholesky factor P (``P P^T = Sigma^-1``), shape (K, D, D)."""
+    identity = np.eye(covariances.shape[1])
+    factors = np.empty_like(covariances)
+    for k, covariance in enumerate(covariances):
+        lower = linalg.cholesky(covariance, lower=True)
+        factors[k] = linalg.solve_triangular(lower, identity, lower=True).T
+    return factors
+
+
+def _e_step(points, weights, means, covariances):
+    """``(l, log r)``: each point's log-likelihood (N,) and log-responsibilities (N, K)."""
+    d = points.shape[1]
+    log_rho = np.empty((len(points), len(weights)))
+    for k, factor in enumerate(_precision_factors(covariances)):
+        y = points @ factor - means[k] @ factor
+        log_det = np.sum(np.log(np.diag(factor)))
+        log_rho[:, k] = -0.5 * (d * np.log(2 * np.pi) + np.sum(np.square(y), axis=1)) + log_det + np.log(weights[k])
+    log_likelihood = logsumexp(log_rho, axis=1)
+    return log_likelihood, log_rho - log_likelihood[:, None]
+
+
+def _m_step(points, responsibilities, reg_covar):
+    n_k = responsibilities.sum(axis=0) + 10 * np.finfo(float).eps
+    means = responsibilities.T @ points / n_k[:, None]
+    covariances = np.empty((len(n_k), points.shape[1], points.shape[1]))
+    for k in range(len(n_k)):
+        centred = points - means[k]
+        covariances[k] = (responsibilities[:, k] * centred.T) @ centred / n_k[k]
+        covariances[k].flat[:: points.shape[1] + 1] += reg_covar
+    return n_k / n_k.sum(), means, covariances
+
+
+@_documented
+def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
+    points = as_points(points, min_columns=1, allow_empty=False)
+    weights, means, covariances = _mixture(weights, means, covariances, points.shape[1])
+    max_iter = check_integer(max_iter, "max_iter", low=1)
+    tol = check_scalar(tol, "tol", low=0.0)
+    reg_covar = check_scalar(reg_covar, "reg_covar", low=0.0)
+    lower_bounds = []
+    for t in range(1, max_iter + 1):
+        log_likelihood, log_responsibilities = _e_step(points, weights, means, covariances)
+        lower_bounds.append(float(log_likelihood.mean()))
+        weights, means, covariances = _m_step(points, np.exp(log_responsibilities), reg_covar)
+        if t > 1 and abs(lower_bounds[-1] - lower_bounds[-2]) < tol:
+            break
+    _, log_responsibilities = _e_step(points, weights, means, covariances)
+    return weights, means, covariances, np.exp(log_responsibilities), np.array(lower_bounds), len(lower_bounds)
 
 
 def _candidate_pairs(points, eps):

@@ -881,3 +881,260 @@ def test_euclidean_clusters_rejects_bad_arguments(impl):
         with raises(ValueError, naming=name):
             impl.euclidean_clusters(**arguments)
     check_array(impl.euclidean_clusters(points, 1.0, np.int64(2), np.int64(50)), "labels", shape=(50,), dtype="int64")
+
+
+# --- gmm_em ------------------------------------------------------------------------------
+
+
+# Different correct codings of EM (a Cholesky solve or an inverse, another summation order) agree to
+# about 1e-12 relative after many iterations; the responsibilities to about 1e-12 absolute.
+EM_RTOL = 1e-9
+EM_ATOL = 1e-9
+
+
+def _mixture_start(points, k, seed):
+    """Initial parameters: equal weights, means at ``k`` points, identity-scaled covariances."""
+    rng = np.random.default_rng(seed)
+    d = points.shape[1]
+    weights = rng.dirichlet(np.full(k, 4.0))
+    means = points[rng.choice(len(points), k, replace=False)].copy()
+    a = rng.normal(size=(k, d, d)) * 0.3
+    covariances = a @ a.transpose(0, 2, 1) + np.eye(d) * np.var(points, axis=0).mean()
+    return weights, means, covariances
+
+
+def _scikit_learn_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
+    """scikit-learn's GaussianMixture from the same parameters: the contract's rules."""
+    import warnings
+
+    from sklearn.mixture import GaussianMixture
+
+    fitted = GaussianMixture(
+        len(weights),
+        covariance_type="full",
+        tol=tol,
+        reg_covar=reg_covar,
+        max_iter=max_iter,
+        weights_init=weights,
+        means_init=means,
+        precisions_init=np.linalg.inv(covariances),
+        init_params="random_from_data",
+        random_state=0,
+    )
+    with warnings.catch_warnings():  # "did not converge": a truncated run is the point here
+        warnings.simplefilter("ignore")
+        fitted.fit(points)
+    lower_bounds = np.array(fitted.lower_bounds_)
+    parameters = (fitted.weights_, fitted.means_, fitted.covariances_)
+    return (*parameters, fitted.predict_proba(points), lower_bounds, fitted.n_iter_)
+
+
+def _unpack_em(result, n, k, d):
+    if not isinstance(result, tuple) or len(result) != 6:
+        raise CheckFailed(
+            "gmm_em must return a tuple (weights, means, covariances, responsibilities, lower_bounds, n_iter), "
+            f"got {type(result).__name__}"
+        )
+    weights, means, covariances, responsibilities, lower_bounds, n_iter = result
+    check_array(weights, "weights", shape=(k,))
+    check_array(means, "means", shape=(k, d))
+    check_array(covariances, "covariances", shape=(k, d, d))
+    check_array(responsibilities, "responsibilities", shape=(n, k))
+    check_array(lower_bounds, "lower_bounds", shape=(None,))
+    if isinstance(n_iter, bool) or not isinstance(n_iter, int | np.integer):
+        raise CheckFailed(f"n_iter must be an int, got {type(n_iter).__name__}")
+    if not 1 <= n_iter or len(lower_bounds) != n_iter:
+        raise CheckFailed(
+            f"n_iter = {n_iter} but lower_bounds holds {len(lower_bounds)} values: n_iter counts the iterations, "
+            "each records one lower bound at its E-step"
+        )
+    return weights, means, covariances, responsibilities, lower_bounds, int(n_iter)
+
+
+def _check_em(impl, points, start, max_iter=100, tol=1e-3, reg_covar=1e-6, expected=None, what=""):
+    """gmm_em against ``expected`` (scikit-learn's by default), the first differing output named."""
+    n, d = points.shape
+    k = len(start[0])
+    result = _unpack_em(impl.gmm_em(points, *start, max_iter, tol, reg_covar), n, k, d)
+    expected = _scikit_learn_em(points, *start, max_iter, tol, reg_covar) if expected is None else expected
+    lower_bounds, n_iter = result[4], result[5]
+    steps = min(n_iter, expected[5])
+    check_close(
+        lower_bounds[:steps],
+        expected[4][:steps],
+        "lower_bounds",
+        rtol=EM_RTOL,
+        atol=EM_ATOL,
+        hint=f"lower_bounds[t - 1] is the mean log-likelihood of the parameters iteration t starts from{what}",
+    )
+    if n_iter != expected[5]:
+        raise CheckFailed(
+            f"n_iter = {n_iter}, expected {expected[5]}{what}: after iteration t's M-step, stop when t > 1 and "
+            "|lower_bounds[t - 1] - lower_bounds[t - 2]| < tol, else go on up to max_iter",
+            rule="EM stops when the lower bound changes by less than tol",
+        )
+    for index, name in enumerate(("weights", "means", "covariances", "responsibilities")):
+        check_close(result[index], expected[index], name, rtol=EM_RTOL, atol=EM_ATOL, hint=what.strip(" ()"))
+    return result
+
+
+def _anisotropic(seed, n=500, columns=2):
+    rng = np.random.default_rng(seed)
+    parts = []
+    for _ in range(3):
+        shear = rng.normal(size=(columns, columns)) * 0.6 + np.eye(columns)
+        parts.append(rng.normal(size=(n // 3, columns)) @ shear + rng.uniform(-6, 6, columns))
+    return np.vstack(parts)
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_gmm_em_returns_the_parameters_responsibilities_and_bounds(impl):
+    points = _anisotropic(31, 300)
+    weights, _, _, responsibilities, _, _ = _unpack_em(impl.gmm_em(points, *_mixture_start(points, 3, 31)), 300, 3, 2)
+    check_close(responsibilities.sum(axis=1), np.ones(300), "the sum of each row of responsibilities", rtol=1e-12)
+    check_close(weights.sum(), 1.0, "the sum of the weights", rtol=1e-12)
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(2)
+def test_gmm_em_one_component_is_the_sample_mean_and_covariance(impl):
+    # One component: every responsibility is 1, so the first M-step gives the sample mean and the
+    # covariance divided by N (plus 10 eps in N); the second E-step's bound is -(D log(2 pi) +
+    # log det Sigma + D) / 2, and the third repeats it: EM stops at n_iter = 3.
+    rng = np.random.default_rng(32)
+    points = rng.normal(size=(400, 3)) @ np.array([[2.0, 0.0, 0.0], [0.5, 1.0, 0.0], [0.0, 0.3, 0.5]]) + 10.0
+    start = (np.array([1.0]), np.zeros((1, 3)), np.eye(3)[None])
+    weights, means, covariances, responsibilities, lower_bounds, n_iter = _unpack_em(
+        impl.gmm_em(points, *start, 100, 1e-9, 0.0), 400, 1, 3
+    )
+    centred = points - points.mean(axis=0)
+    sample = centred.T @ centred / (400 + 10 * np.finfo(float).eps)
+    check_close(means[0], points.mean(axis=0), "means", rtol=1e-12, hint="one component: the sample mean")
+    check_close(covariances[0], sample, "covariances", rtol=1e-10, hint="one component: divided by N, not N - 1")
+    bound = -(3 * np.log(2 * np.pi) + np.linalg.slogdet(sample)[1] + 3) / 2
+    check_close(lower_bounds[1:], [bound, bound], "lower_bounds[1:]", rtol=1e-10, hint="the Gaussian's entropy bound")
+    if n_iter != 3:
+        raise CheckFailed(f"n_iter = {n_iter}, expected 3: the third iteration's bound repeats the second's")
+    check_close(responsibilities, np.ones((400, 1)), "responsibilities", rtol=0, atol=1e-12)
+    check_close(weights, [1.0], "weights", rtol=1e-15)
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(4)
+def test_gmm_em_matches_scikit_learn_from_the_same_parameters(impl):
+    cases = [
+        (_anisotropic(33, 600), 3, 1e-3),
+        (_anisotropic(34, 450, columns=3), 4, 1e-6),
+        (_blobs(300, centres=2, columns=1, seed=35), 2, 1e-8),
+        (_blobs(400, centres=3, columns=5, seed=36), 3, 1e-5),
+    ]
+    for points, k, tol in cases:
+        start = _mixture_start(points, k, len(points))
+        _check_em(impl, points, start, 200, tol, what=f" ({points.shape[1]} columns, K = {k}, tol = {tol:g})")
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(2)
+def test_gmm_em_truncated_runs_are_the_first_iterations(impl):
+    points = _anisotropic(37, 450)
+    start = _mixture_start(points, 3, 37)
+    for max_iter in (1, 2, 5):
+        _check_em(impl, points, start, max_iter, 0.0, what=f" (max_iter = {max_iter}, tol = 0)")
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(2)
+def test_gmm_em_stops_at_the_first_small_change(impl):
+    # tol between two consecutive changes of the bound: EM stops exactly after the smaller one.
+    points = _anisotropic(38, 600)
+    start = _mixture_start(points, 3, 38)
+    bounds = _scikit_learn_em(points, *start, 40, 0.0)[4]
+    changes = np.abs(np.diff(bounds))  # changes[i]: between iterations i + 1 and i + 2
+    t = next(i for i in range(2, len(changes)) if changes[i] < changes[:i].min() * 0.5)
+    tol = float(np.sqrt(changes[t] * changes[:t].min()))  # every earlier change > tol > changes[t]
+    assert changes[:t].min() > tol > changes[t]  # the test's own premise
+    _check_em(impl, points, start, 100, tol, what=f" (tol between the changes of iterations {t + 1} and {t + 2})")
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(2)
+def test_gmm_em_works_in_the_log_domain(impl):
+    # A point hundreds of standard deviations from every component: its densities underflow to 0 in
+    # floating point (exp(-1e5)); the log domain (logsumexp) keeps its responsibilities.
+    points = np.vstack([_anisotropic(39, 300), [[400.0, -300.0]]])
+    start = _mixture_start(points[:-1], 3, 39)
+    _check_em(impl, points, start, 20, 1e-6, what=" (a point far from every component: compute in the log domain)")
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(2)
+def test_gmm_em_regularises_a_collapsing_component(impl):
+    # Component 2 starts on five copies of one point, far from the rest: it keeps them alone, and its
+    # covariance is reg_covar I (without reg_covar it would be singular).
+    rng = np.random.default_rng(40)
+    points = np.vstack([rng.normal(0, 1, (200, 2)), rng.normal([6, 0], 1, (200, 2)), np.tile([[30.0, 30.0]], (5, 1))])
+    start = (np.array([0.45, 0.45, 0.1]), np.array([[0.0, 0.0], [6.0, 0.0], [30.0, 30.0]]), np.stack([np.eye(2)] * 3))
+    for reg_covar in (1e-6, 1e-2):
+        result = _check_em(impl, points, start, 50, 1e-8, reg_covar, what=f" (reg_covar = {reg_covar:g})")
+        check_close(result[2][2], reg_covar * np.eye(2), "covariances[2]", rtol=1e-8, atol=1e-14)
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(1)
+def test_gmm_em_never_lowers_the_likelihood(impl):
+    points = _anisotropic(41, 600, columns=3)
+    lower_bounds = _unpack_em(impl.gmm_em(points, *_mixture_start(points, 4, 41), 60, 0.0, 0.0), 600, 4, 3)[4]
+    drops = np.diff(lower_bounds) < -1e-10 * np.abs(lower_bounds[1:])
+    if np.any(drops):
+        t = int(np.argmax(drops)) + 1
+        raise CheckFailed(
+            f"lower_bounds[{t}] < lower_bounds[{t - 1}]: EM never lowers the likelihood (reg_covar = 0); each "
+            "iteration records the bound of the parameters it starts from, then updates all of them",
+            rule="the likelihood never decreases",
+        )
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_gmm_em_converts_float32_and_modifies_nothing(impl):
+    points = _anisotropic(42, 300)
+    start = _mixture_start(points, 3, 42)
+    result = _unpack_em(impl.gmm_em(points.astype(np.float32), *start, 20, 0.0), 300, 3, 2)
+    check_unmodified(impl, "gmm_em")
+    _check_em(impl, points.astype(np.float32).astype(np.float64), start, 20, 0.0, expected=result, what=" (float32)")
+    check_unmodified(impl, "gmm_em")
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(1)
+@pytest.mark.interface
+def test_gmm_em_rejects_bad_arguments(impl):
+    points = _anisotropic(43, 90)
+    weights, means, covariances = _mixture_start(points, 3, 43)
+    asymmetric = covariances.copy()
+    asymmetric[0, 0, 1] += 0.5
+    cases = [
+        ({"points": points[:, 0]}, "points"),
+        ({"points": np.empty((0, 2))}, "points"),
+        ({"weights": np.array([0.5, 0.5])}, "means"),  # K = 2 from the weights: the means do not match
+        ({"weights": np.array([0.5, 0.6, -0.1])}, "weights"),
+        ({"weights": weights * 2}, "weights"),
+        ({"weights": np.array([1.0, 0.0, 0.0])}, "weights"),
+        ({"means": means[:, :1]}, "means"),
+        ({"means": np.full((3, 2), np.nan)}, "means"),
+        ({"covariances": covariances[:, :1, :1]}, "covariances"),
+        ({"covariances": asymmetric}, "covariances"),
+        ({"covariances": -covariances}, "covariances"),
+        ({"max_iter": 0}, "max_iter"),
+        ({"max_iter": 2.5}, "max_iter"),
+        ({"tol": -1.0}, "tol"),
+        ({"tol": np.nan}, "tol"),
+        ({"reg_covar": -1e-6}, "reg_covar"),
+    ]
+    for change, name in cases:
+        arguments = {"points": points, "weights": weights, "means": means, "covariances": covariances, **change}
+        with raises(ValueError, naming=name):
+            impl.gmm_em(**arguments)
