@@ -119,7 +119,7 @@ def _e_step(points, weights, means, covariances):
     d = points.shape[1]
     log_rho = np.empty((len(points), len(weights)))
     for k, factor in enumerate(_precision_factors(covariances)):
-        y = points @ factor - means[k] @ factor
+        y = (points - means[k]) @ factor  # centred first: x @ P - mu @ P loses digits far from the origin
         log_det = np.sum(np.log(np.diag(factor)))
         log_rho[:, k] = -0.5 * (d * np.log(2 * np.pi) + np.sum(np.square(y), axis=1)) + log_det + np.log(weights[k])
     log_likelihood = logsumexp(log_rho, axis=1)
