@@ -1,0 +1,12 @@
+"""Records the log-likelihood of the parameters after the M-step, not of those the iteration started from."""
+
+from solutions.cluster import *  # noqa: F401,F403
+from solutions.cluster import gmm_em as _reference
+from tests.mutants import _plain_em
+
+MISTAKE = "bound_after_m_step"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
+
+
+def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
+    _reference(points, weights, means, covariances, max_iter, tol, reg_covar)  # validation only
+    return _plain_em.gmm_em(points, weights, means, covariances, max_iter, tol, reg_covar, bound_after_m_step=True)

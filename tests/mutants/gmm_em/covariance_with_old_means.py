@@ -1,0 +1,12 @@
+"""Centres the covariance on the means the M-step started from, not on the ones it just computed."""
+
+from solutions.cluster import *  # noqa: F401,F403
+from solutions.cluster import gmm_em as _reference
+from tests.mutants import _plain_em
+
+MISTAKE = "covariance_with_old_means"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
+
+
+def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
+    _reference(points, weights, means, covariances, max_iter, tol, reg_covar)  # validation only
+    return _plain_em.gmm_em(points, weights, means, covariances, max_iter, tol, reg_covar, old_means_in_covariance=True)

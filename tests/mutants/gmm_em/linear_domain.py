@@ -1,0 +1,13 @@
+"""Computes the densities pi_k N(x_n) themselves and normalises them: far from every component they
+underflow to 0, and the responsibilities are 0 / 0."""
+
+from solutions.cluster import *  # noqa: F401,F403
+from solutions.cluster import gmm_em as _reference
+from tests.mutants import _plain_em
+
+MISTAKE = "linear_domain"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
+
+
+def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
+    _reference(points, weights, means, covariances, max_iter, tol, reg_covar)  # validation only
+    return _plain_em.gmm_em(points, weights, means, covariances, max_iter, tol, reg_covar, log_domain=False)

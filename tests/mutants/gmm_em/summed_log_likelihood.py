@@ -1,0 +1,13 @@
+"""Records the total log-likelihood (a sum over the points), not its mean: the bounds are N times the
+contract's, and tol applies to the sum."""
+
+from solutions.cluster import *  # noqa: F401,F403
+from solutions.cluster import gmm_em as _reference
+from tests.mutants import _plain_em
+
+MISTAKE = "summed_log_likelihood"  # the diagnosis this mistake must get (grading/instructors/mistakes/)
+
+
+def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
+    _reference(points, weights, means, covariances, max_iter, tol, reg_covar)  # validation only
+    return _plain_em.gmm_em(points, weights, means, covariances, max_iter, tol, reg_covar, bound="sum")
