@@ -19,6 +19,7 @@ to a :class:`Model` or to None (no catalogue: said, not forgotten).
 """
 
 import importlib
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -54,6 +55,25 @@ def valid_points(points, min_columns=1, max_columns=None, min_rows=0):
     if max_columns is not None and data.shape[1] > max_columns:
         raise ValueError("not a valid cloud")
     return data
+
+
+def valid_integer(value, low):
+    """``value`` as an int if the contract accepts it as an integer >= ``low`` (a NumPy integer too,
+    never a bool), else ValueError: a truth raises where the contract does."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iu":
+        value = value.item()
+    if not isinstance(value, numbers.Integral) or isinstance(value, bool) or int(value) < low:
+        raise ValueError("not an integer in range")
+    return int(value)
+
+
+def valid_positive(value):
+    """``value`` as a float if the contract accepts it as a positive finite real number, else ValueError."""
+    if isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        value = value.item()
+    if not isinstance(value, numbers.Real) or isinstance(value, bool) or not 0 < float(value) < np.inf:
+        raise ValueError("not a positive finite number")
+    return float(value)
 
 
 def _default_same(a, b, arguments):
