@@ -17,8 +17,8 @@ Labels
     numbering, so that answers compare exactly, with no matching of labels.
 
 Ties
-    Wherever a rule takes a minimum over centres or labels, **ties go to
-    the lowest index**.
+    Wherever a rule takes a minimum or a maximum over centres or
+    components, **ties go to the lowest index**.
 
 Randomness
     :func:`kmeans` and :func:`gmm_em` are deterministic: they start from
@@ -240,9 +240,11 @@ def dbscan(points, eps, min_samples):
     4. Every other point is **noise**, labelled -1.
 
     The answer depends on no visiting order. The neighbourhood is
-    inclusive: two points exactly ``eps`` apart are neighbours
-    (scikit-learn's ``DBSCAN`` follows these rules; Open3D's
-    ``cluster_dbscan`` takes ``s < eps ** 2``).
+    inclusive: two points exactly ``eps`` apart (``s == eps ** 2``) are
+    neighbours. scikit-learn's ``DBSCAN`` follows these rules, but for
+    rounding where a distance is within an ulp of ``eps`` (it compares the
+    distance with ``eps``, the contract the squared distance with
+    ``eps ** 2``); Open3D's ``cluster_dbscan`` takes ``s < eps ** 2``.
 
     Parameters
     ----------

@@ -678,6 +678,10 @@ class LidarScan:
         attenuated with range.
     labels : ndarray of int64, shape (N,)
         Index into :data:`LIDAR_CLASSES`; -1 for a spurious return.
+    objects : ndarray of int64, shape (N,)
+        The object each return hit, numbered in the order of
+        :func:`make_street_scene`'s meshes (0: the ground; a tree's trunk and
+        crown are one object); -1 for a spurious return.
     normals : ndarray of float64, shape (N, 3)
         Ground-truth surface normals (facing the sensor); NaN for spurious returns.
     ring : ndarray of int64, shape (N,)
@@ -689,6 +693,7 @@ class LidarScan:
     points: np.ndarray
     intensity: np.ndarray
     labels: np.ndarray
+    objects: np.ndarray
     normals: np.ndarray
     ring: np.ndarray
     is_outlier: np.ndarray
@@ -806,10 +811,15 @@ def simulate_lidar_scan(
 
     rng = check_rng(seed, "seed")
     scene = o3d.t.geometry.RaycastingScene()
-    label_of_geometry = {}
+    label_of_geometry, object_of_geometry, n_objects, n_vegetation = {}, {}, 0, 0
     for mesh, label in make_street_scene(rng):
         geometry_id = scene.add_triangles(o3d.t.geometry.TriangleMesh.from_legacy(mesh))
         label_of_geometry[geometry_id] = LIDAR_CLASSES.index(label)
+        # The vegetation meshes come in pairs, a trunk then its crown: one tree, one object.
+        crown = label == "vegetation" and n_vegetation % 2 == 1
+        n_vegetation += label == "vegetation"
+        object_of_geometry[geometry_id] = n_objects - 1 if crown else n_objects
+        n_objects += not crown
 
     elevation = np.deg2rad(np.linspace(fov[0], fov[1], n_beams))
     azimuth = np.linspace(-np.pi, np.pi, n_azimuth, endpoint=False)
@@ -824,6 +834,7 @@ def simulate_lidar_scan(
     directions, ring, t_hit = directions[hit], ring[hit], t_hit[hit]
     geometry = hits["geometry_ids"].numpy()[hit]
     labels = np.array([label_of_geometry[g] for g in geometry], dtype=np.int64)
+    objects = np.array([object_of_geometry[g] for g in geometry], dtype=np.int64)
     normals = hits["primitive_normals"].numpy()[hit].astype(np.float64)
     normals = _unit(normals)
     facing = np.sum(normals * directions, axis=1) > 0
@@ -845,6 +856,7 @@ def simulate_lidar_scan(
         points=np.vstack([points, outliers]),
         intensity=np.concatenate([intensity, rng.uniform(0.0, 0.2, n_out)]),
         labels=np.concatenate([labels, np.full(n_out, -1, dtype=np.int64)]),
+        objects=np.concatenate([objects, np.full(n_out, -1, dtype=np.int64)]),
         normals=np.vstack([normals, np.full((n_out, 3), np.nan)]),
         ring=np.concatenate([ring, ring[source]]),
         is_outlier=np.concatenate([np.zeros(n, dtype=bool), np.ones(n_out, dtype=bool)]),

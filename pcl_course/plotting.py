@@ -46,6 +46,9 @@ __all__ = [
     "kmeans_trajectories",
     "ratio_distributions",
     "cluster_panels",
+    "density_panels",
+    "k_distance_curve",
+    "clusters_top_view",
 ]
 
 
@@ -1277,5 +1280,120 @@ def cluster_panels(panels, columns=None, figsize=(11, 3.4)):
         ax.set(title=title, aspect="equal", xticks=[], yticks=[])
     for ax in axes.flat[len(panels) :]:
         ax.axis("off")
+    fig.tight_layout()
+    plt.show()
+
+
+def _cluster_colours(labels):
+    """One colour per cluster label, light grey for noise (-1): tab20's ten dark colours, then its ten
+    light ones, cycling (so that clusters 0 and 1 do not get two shades of one colour)."""
+    import matplotlib.pyplot as plt
+
+    labels = np.asarray(labels)
+    k = np.mod(labels, 20)
+    colours = plt.cm.tab20(2 * (k % 10) + k // 10)
+    colours[labels < 0] = (0.75, 0.75, 0.75, 1.0)
+    return colours
+
+
+def density_panels(panels, columns=None, figsize=(11, 3.6), eps=None, numbered=False):
+    """2-D clouds clustered by DBSCAN, one panel each: core points filled, border points hollow, noise grey crosses.
+
+    Parameters
+    ----------
+    panels : dict of str to (array_like of shape (N, 2), array_like of shape (N,), array_like of shape (N,))
+        Title -> the points, their labels (-1 for noise) and whether each is a core point.
+    columns : int, optional
+        Panels per row; default, all in one row.
+    figsize : tuple of float, default (11, 3.6)
+    eps : float, optional
+        If given, a dashed circle of this radius around every core point (its neighbourhood).
+    numbered : bool, default False
+        Write each point's index above it (for small examples).
+    """
+    import matplotlib.pyplot as plt
+
+    if not panels:
+        raise ValueError("panels: nothing to draw")  # before a figure exists: no empty figure is shown
+    columns = len(panels) if columns is None else columns
+    rows = -(-len(panels) // columns)
+    fig, axes = plt.subplots(rows, columns, figsize=figsize, squeeze=False)
+    for ax, (title, (points, labels, is_core)) in zip(axes.flat, panels.items()):
+        points, labels = np.asarray(points, dtype=float), np.asarray(labels)
+        is_core = np.asarray(is_core, dtype=bool)
+        colours = _cluster_colours(labels)
+        small = len(points) <= 50
+        core_size, border_size = (90, 70) if small else (9, 9)
+        noise, border = labels < 0, (labels >= 0) & ~is_core
+        ax.scatter(*points[is_core].T, s=core_size, c=colours[is_core], lw=0, label="core")
+        ax.scatter(*points[border].T, s=border_size, facecolors="none", edgecolors=colours[border],
+                   lw=1.5 if small else 0.8, label="border")  # fmt: skip
+        ax.scatter(*points[noise].T, s=border_size, c="0.45", marker="x", lw=1.2 if small else 0.6, label="noise")
+        if eps is not None:
+            for centre, colour in zip(points[is_core], colours[is_core]):
+                ax.add_patch(plt.Circle(centre, eps, fill=False, ls="--", lw=0.8, ec=colour, alpha=0.7))
+        if numbered:
+            for i, (x, y) in enumerate(points):
+                ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(0, 8), ha="center", fontsize=8)
+        ax.set(title=title, aspect="equal")
+        if not small:
+            ax.set(xticks=[], yticks=[])
+    axes.flat[len(panels) - 1].legend(loc="upper left", bbox_to_anchor=(1.01, 1), fontsize=8)
+    for ax in axes.flat[len(panels) :]:
+        ax.axis("off")
+    fig.tight_layout()
+    plt.show()
+
+
+def k_distance_curve(distances, min_samples, marks, figsize=(7, 3.8)):
+    """The k-distance plot: every point's distance to its ``min_samples``-th neighbour, sorted.
+
+    Parameters
+    ----------
+    distances : array_like of shape (N,)
+        Each point's distance to its ``min_samples``-th nearest point, itself counted as the first.
+    min_samples : int
+        For the axis label.
+    marks : dict of str to float
+        Label -> a radius drawn as a horizontal line (a candidate ``eps``).
+    figsize : tuple of float, default (7, 3.8)
+    """
+    import matplotlib.pyplot as plt
+
+    distances = np.sort(np.asarray(distances, dtype=float))
+    fig, ax = plt.subplots(figsize=figsize)
+    ax.plot(np.arange(len(distances)), distances, c="k", lw=1.2)
+    for k, (label, radius) in enumerate(marks.items()):
+        share = np.mean(distances <= radius)
+        ax.axhline(radius, c=f"C{k}", ls="--", lw=1, label=f"{label}: {share:.0%} of the points are core")
+    ax.set(xlabel="points, sorted by their k-distance",
+           ylabel=f"distance to the {min_samples}-th nearest point\n(itself counted)")  # fmt: skip
+    ax.grid(alpha=0.3)
+    ax.legend(loc="upper left", fontsize=8)
+    fig.tight_layout()
+    plt.show()
+
+
+def clusters_top_view(panels, figsize=(11, 8), xlim=(-40, 40), ylim=(-14, 14), size=1.0):
+    """Bird's-eye views of labelled clouds, one panel each: a colour per label, noise (-1) grey.
+
+    Parameters
+    ----------
+    panels : dict of str to (array_like of shape (N, 3), array_like of shape (N,))
+        Title -> the points (metres) and their labels.
+    figsize : tuple of float, default (11, 8)
+    xlim, ylim : tuple of float
+        The window shown, metres.
+    size : float, default 1.0
+        The markers' area, points squared.
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(panels), 1, figsize=figsize, squeeze=False)
+    for ax, (title, (points, labels)) in zip(axes.flat, panels.items()):
+        points, labels = np.asarray(points, dtype=float), np.asarray(labels)
+        order = np.argsort(labels >= 0, kind="stable")  # noise first, under the clusters
+        ax.scatter(*points[order, :2].T, s=size, c=_cluster_colours(labels[order]), lw=0)
+        ax.set(title=title, xlim=xlim, ylim=ylim, aspect="equal", xlabel="x (m)", ylabel="y (m)")
     fig.tight_layout()
     plt.show()

@@ -184,6 +184,19 @@ def test_lidar_scan_sees_every_class_and_labels_its_outliers(scan):
     assert 0.001 < scan.is_outlier.mean() < 0.02
 
 
+def test_lidar_scan_numbers_its_objects(scan):
+    # book/dbscan.md clusters the objects and scores the clusters against them.
+    assert scan.objects.shape == scan.labels.shape and scan.objects.dtype == np.int64
+    assert np.array_equal(scan.objects == -1, scan.is_outlier)
+    assert np.all(scan.objects[scan.labels == datasets.LIDAR_CLASSES.index("ground")] == 0)
+    inliers = ~scan.is_outlier
+    pairs = np.unique(np.column_stack([scan.objects[inliers], scan.labels[inliers]]), axis=0)
+    assert len(pairs) == len(np.unique(pairs[:, 0]))  # one class per object
+    trees = pairs[pairs[:, 1] == datasets.LIDAR_CLASSES.index("vegetation"), 0]
+    tops = [scan.points[scan.objects == tree, 2].max() for tree in trees]
+    assert max(tops) > 2.5 - datasets.SENSOR_HEIGHT + 0.5  # a tree's object holds its crown, above its trunk
+
+
 def test_lidar_ground_points_lie_on_the_ground_plane(scan):
     ground = scan.labels == datasets.LIDAR_CLASSES.index("ground")
     assert np.abs(scan.points[ground, 2] + datasets.SENSOR_HEIGHT).max() < 0.2
