@@ -241,10 +241,11 @@ def dbscan(points, eps, min_samples):
 
     The answer depends on no visiting order. The neighbourhood is
     inclusive: two points exactly ``eps`` apart (``s == eps ** 2``) are
-    neighbours. scikit-learn's ``DBSCAN`` follows these rules, but for
-    rounding where a distance is within an ulp of ``eps`` (it compares the
-    distance with ``eps``, the contract the squared distance with
-    ``eps ** 2``); Open3D's ``cluster_dbscan`` takes ``s < eps ** 2``.
+    neighbours. scikit-learn's ``DBSCAN`` follows these rules, except where
+    a distance lies within rounding of ``eps``: there its answer depends on
+    the neighbour search it picks (its brute force expands the squared
+    distance as ``|p|^2 - 2 p.q + |q|^2``; its trees may take a whole node
+    at once). Open3D's ``cluster_dbscan`` takes ``s < eps ** 2``.
 
     Parameters
     ----------
@@ -287,7 +288,11 @@ def euclidean_clusters(points, tolerance, min_size=1, max_size=None):
        clusters of equal size by their smallest point index.
 
     This is :func:`dbscan` with ``min_samples = 1`` (every point core),
-    size filters and another numbering (PCL's: largest first).
+    size filters and another numbering (PCL's: largest first). Two rules
+    are the contract's, not PCL's: the links are inclusive (PCL's k-d tree
+    keeps ``s < tolerance ** 2``, in float32), and clusters of equal size
+    are ordered by their smallest index (PCL's sort leaves them in no fixed
+    order).
 
     Parameters
     ----------

@@ -1285,13 +1285,15 @@ def cluster_panels(panels, columns=None, figsize=(11, 3.4)):
 
 
 def _cluster_colours(labels):
-    """One colour per cluster label, light grey for noise (-1): tab20's ten dark colours, then its ten
-    light ones, cycling (so that clusters 0 and 1 do not get two shades of one colour)."""
+    """One colour per cluster label, light grey for noise (-1): tab20's dark colours, then its light
+    ones, cycling (so that clusters 0 and 1 do not get two shades of one colour), without its two
+    greys (a grey cluster would read as noise)."""
     import matplotlib.pyplot as plt
 
     labels = np.asarray(labels)
-    k = np.mod(labels, 20)
-    colours = plt.cm.tab20(2 * (k % 10) + k // 10)
+    dark = [i for i in range(0, 20, 2) if i != 14]  # tab20's 14 and 15 are its greys
+    palette = plt.cm.tab20(np.array(dark + [i + 1 for i in dark]))
+    colours = palette[np.mod(labels, len(palette))]
     colours[labels < 0] = (0.75, 0.75, 0.75, 1.0)
     return colours
 
