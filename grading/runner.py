@@ -14,6 +14,7 @@ import tempfile
 import threading
 
 from grading import GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT
+from grading.config import GRADER_ENVIRONMENT
 from grading.options import pytest_arguments
 from grading.results import clean
 
@@ -64,7 +65,7 @@ def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None,
         command += ["--junitxml", str(junit)]
     # Only the plugins named above: the environment's others (nbval, dash,
     # pytest-benchmark, xdist) have no say in a grade, and importing them costs 0.2 s a grade.
-    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", PYTEST_DISABLE_PLUGIN_AUTOLOAD="1")
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", PYTEST_DISABLE_PLUGIN_AUTOLOAD="1", **GRADER_ENVIRONMENT)
     folder = tempfile.mkdtemp(prefix="grading-options-")  # mode 0700: the grader's user only
     options_file = os.path.join(folder, "options.json")
     reader = writer = None

@@ -190,10 +190,14 @@ def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_cova
         Largest number of iterations, >= 1.
     tol : float, default 1e-3
         The change of the average log-likelihood below which EM stops,
-        >= 0 (0: run ``max_iter`` iterations unless it stops changing).
+        >= 0 (0: always run ``max_iter`` iterations, as ``|change| < 0``
+        never holds).
     reg_covar : float, default 1e-6
         Added to the diagonal of every covariance the M-step computes
         (keeps a component on too few points positive definite), >= 0.
+        With 0, a covariance the M-step computes may be singular (a
+        component on fewer than D + 1 distinct points): then a
+        ``ValueError`` naming ``reg_covar``, as scikit-learn raises.
 
     Returns
     -------
@@ -217,7 +221,8 @@ def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_cova
         wrong shape, not finite, weights not positive or not summing to 1,
         a covariance not symmetric or not positive definite; ``max_iter``
         not an integer >= 1; ``tol`` or ``reg_covar`` not a finite number
-        >= 0.
+        >= 0; a covariance computed by an M-step not positive definite
+        (``reg_covar`` too small).
     """
     raise NotImplementedError("gmm_em: not implemented yet")
 

@@ -145,13 +145,18 @@ def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_cova
     tol = check_scalar(tol, "tol", low=0.0)
     reg_covar = check_scalar(reg_covar, "reg_covar", low=0.0)
     lower_bounds = []
-    for t in range(1, max_iter + 1):
-        log_likelihood, log_responsibilities = _e_step(points, weights, means, covariances)
-        lower_bounds.append(float(log_likelihood.mean()))
-        weights, means, covariances = _m_step(points, np.exp(log_responsibilities), reg_covar)
-        if t > 1 and abs(lower_bounds[-1] - lower_bounds[-2]) < tol:
-            break
-    _, log_responsibilities = _e_step(points, weights, means, covariances)
+    try:
+        for t in range(1, max_iter + 1):
+            log_likelihood, log_responsibilities = _e_step(points, weights, means, covariances)
+            lower_bounds.append(float(log_likelihood.mean()))
+            weights, means, covariances = _m_step(points, np.exp(log_responsibilities), reg_covar)
+            if t > 1 and abs(lower_bounds[-1] - lower_bounds[-2]) < tol:
+                break
+        _, log_responsibilities = _e_step(points, weights, means, covariances)
+    except linalg.LinAlgError:  # only an M-step's covariance can fail: the initial ones were checked
+        raise ValueError(
+            f"a covariance became singular in iteration {len(lower_bounds)}: reg_covar = {reg_covar} is too small"
+        ) from None
     return weights, means, covariances, np.exp(log_responsibilities), np.array(lower_bounds), len(lower_bounds)
 
 

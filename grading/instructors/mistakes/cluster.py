@@ -21,6 +21,7 @@ import numpy as np
 
 from grading.instructors.mistakes import RANDOM, Mistake, Model, Variants, valid_integer, valid_points
 from grading.instructors.mistakes._density import DBSCAN, EUCLIDEAN_CLUSTERS
+from grading.instructors.mistakes._mixture import GMM_EM
 
 MAX_KMEANS_WORK = 2_000_000_000  # points x centres x columns x iterations replayed
 MAX_SEEDING_WORK = 400_000_000  # points x seeds x columns replayed
@@ -336,7 +337,7 @@ KMEANS_PLUSPLUS = Model(
 MODELS = {
     "kmeans": KMEANS,
     "kmeans_plusplus": KMEANS_PLUSPLUS,
-    "gmm_em": None,  # its catalogue is being written (grading/instructors/mistakes/_mixture.py)
+    "gmm_em": GMM_EM,
     "dbscan": DBSCAN,
     "euclidean_clusters": EUCLIDEAN_CLUSTERS,
 }
