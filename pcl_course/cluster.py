@@ -184,8 +184,9 @@ def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_cova
     means : array_like, shape (K, D)
         The initial means.
     covariances : array_like, shape (K, D, D)
-        The initial covariances, each symmetric (within 1e-10 of its
-        largest entry) and positive definite.
+        The initial covariances, each symmetric (``|Sigma - Sigma^T|``
+        at most 1e-10 times its largest absolute entry) and positive
+        definite.
     max_iter : int, default 100
         Largest number of iterations, >= 1.
     tol : float, default 1e-3

@@ -90,11 +90,12 @@ def check_close(actual, expected, name, rtol=1e-7, atol=1e-9, hint=""):
     error = np.abs(actual - expected)
     error = np.where(np.isnan(error), np.inf, error)
     worst = np.unravel_index(np.argmax(error), error.shape)
-    message = (
-        f"{name} is wrong: at index {tuple(int(i) for i in worst)} expected "
-        f"{expected[worst]:.6g}, got {actual[worst]:.6g}\n"
-        f"  got {preview(actual)}{note}"
-    )
+    shown = f"expected {expected[worst]:.6g}, got {actual[worst]:.6g}"
+    if f"{expected[worst]:.6g}" == f"{actual[worst]:.6g}":  # alike to six digits: show them all, and how far
+        relative = abs(actual[worst] - expected[worst]) / max(abs(expected[worst]), np.finfo(float).tiny)
+        want, got = float(expected[worst]), float(actual[worst])
+        shown = f"expected {want!r}, got {got!r} (a relative difference of {relative:.1e})"
+    message = f"{name} is wrong: at index {tuple(int(i) for i in worst)} {shown}\n  got {preview(actual)}{note}"
     raise CheckFailed(_with_hint(message, hint), rule=f"{name} is wrong")
 
 

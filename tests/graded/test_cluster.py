@@ -673,6 +673,14 @@ def test_dbscan_counts_the_point_itself_and_its_duplicates(impl):
     grid = np.stack(np.meshgrid(np.arange(6.0), np.arange(5.0)), -1).reshape(-1, 2)
     for min_samples in (4, 5, 6):
         _check_dbscan(impl, grid, 1.0, min_samples, what=f" (a unit grid, eps = 1, min_samples = {min_samples})")
+    # More samples than points: nothing is core.
+    _check_dbscan(impl, np.array([[0.0], [0.5]]), 1.0, 5, what=" (min_samples larger than the cloud)")
+    # Just beyond eps: 1 + 1e-10 apart with eps = 1; and sqrt(3) apart with eps = np.sqrt(3), whose
+    # square rounds to 2.9999999999999996 < 3: the contract compares s with eps ** 2, so neither pair
+    # are neighbours (a comparison of sqrt(s) with eps, or with a relative slack, links them).
+    _check_dbscan(impl, np.array([[0.0], [1.0 + 1e-10]]), 1.0, 2, what=" (two points 1 + 1e-10 apart, eps = 1)")
+    diagonal = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
+    _check_dbscan(impl, diagonal, float(np.sqrt(3.0)), 2, what=" (eps = np.sqrt(3): s = 3 > eps ** 2)")
 
 
 @pytest.mark.grades("dbscan")
@@ -703,6 +711,7 @@ def test_dbscan_converts_float32_and_modifies_nothing(impl):
     labels, is_core = _unpack_dbscan(impl.dbscan(points, 0.8, 6), 300)
     check_unmodified(impl, "dbscan")
     _check_dbscan(impl, points.astype(np.float64), 0.8, 6, (labels, is_core), " (float32 points are converted)")
+    check_unmodified(impl, "dbscan")  # float64 points: no conversion copies them
 
 
 @pytest.mark.grades("dbscan")
@@ -722,7 +731,10 @@ def test_dbscan_rejects_bad_arguments(impl):
         ({"eps": True}, "eps"),
         ({"min_samples": 0}, "min_samples"),
         ({"min_samples": 2.5}, "min_samples"),
+        ({"min_samples": 3.0}, "min_samples"),  # a float, if a whole one, is not an integer
         ({"min_samples": True}, "min_samples"),
+        ({"eps": "1.0"}, "eps"),
+        ({"points": np.where(np.arange(150).reshape(50, 3) == 7, np.inf, points)}, "points"),
     ]
     for change, name in cases:
         arguments = {"points": points, "eps": 1.0, "min_samples": 5, **change}
@@ -765,6 +777,13 @@ def _check_components(impl, points, tolerance, min_size=1, max_size=None, expect
             f"yours labels it {labels[p]}{what}",
             rule="a component outside the sizes is dropped (-1)",
         )
+    if labels[p] < 0:
+        size = int(np.sum(want == want[p]))
+        raise CheckFailed(
+            f"point {p} lies in a cluster of {size} points, within the sizes {min_size}..{max_size} (both inclusive): "
+            f"it is kept, as cluster {want[p]}; yours labels it -1{what}",
+            rule="a component within the sizes is kept",
+        )
     sizes = np.bincount(want[want >= 0])
     raise CheckFailed(
         f"point {p} has label {labels[p]}, expected {want[p]}{what}: the clusters are the connected components of "
@@ -793,6 +812,11 @@ def test_euclidean_clusters_on_a_line_worked_by_hand(impl):
     _check_components(impl, points, 1.0, 1, 2, expected=[-1, -1, -1, 0, 0, 1], what=" (max_size = 2)")
     _check_components(impl, points, 3.0, expected=[0] * 6, what=" (tolerance 3: gaps of 3 linked)")
     _check_components(impl, points, 3.0, 1, 5, expected=[-1] * 6, what=" (tolerance 3, max_size = 5)")
+    # Just beyond the tolerance (s compared with tolerance ** 2): not linked.
+    _check_components(impl, np.array([[0.0], [1.0 + 1e-10]]), 1.0, expected=[0, 1], what=" (1 + 1e-10 apart)")
+    diagonal = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
+    root = float(np.sqrt(3.0))
+    _check_components(impl, diagonal, root, expected=[0, 1], what=" (tolerance np.sqrt(3): s = 3 > its square)")
 
 
 @pytest.mark.grades("euclidean_clusters")
@@ -854,6 +878,7 @@ def test_euclidean_clusters_converts_float32_and_modifies_nothing(impl):
     labels = impl.euclidean_clusters(points, 0.6, 2)
     check_unmodified(impl, "euclidean_clusters")
     _check_components(impl, points.astype(np.float64), 0.6, 2, expected=labels, what=" (float32 is converted)")
+    check_unmodified(impl, "euclidean_clusters")  # float64 points: no conversion copies them
 
 
 @pytest.mark.grades("euclidean_clusters")
@@ -871,6 +896,8 @@ def test_euclidean_clusters_rejects_bad_arguments(impl):
         ({"tolerance": True}, "tolerance"),
         ({"min_size": 0}, "min_size"),
         ({"min_size": 1.5}, "min_size"),
+        ({"min_size": 2.0}, "min_size"),
+        ({"points": np.where(np.arange(150).reshape(50, 3) == 7, np.inf, points)}, "points"),
         ({"max_size": 0}, "max_size"),
         ({"min_size": 5, "max_size": 4}, "max_size"),
         ({"max_size": 2.5}, "max_size"),
@@ -1019,6 +1046,13 @@ def test_gmm_em_one_component_is_the_sample_mean_and_covariance(impl):
         raise CheckFailed(f"n_iter = {n_iter}, expected 3: the third iteration's bound repeats the second's")
     check_close(responsibilities, np.ones((400, 1)), "responsibilities", rtol=0, atol=1e-12)
     check_close(weights, [1.0], "weights", rtol=1e-15)
+    # tol = 0: |change| < 0 never holds, so EM runs max_iter iterations though the bound stops changing.
+    n_iter = _unpack_em(impl.gmm_em(points, *start, 6, 0.0, 0.0), 400, 1, 3)[5]
+    if n_iter != 6:
+        raise CheckFailed(
+            f"n_iter = {n_iter} with tol = 0 and max_iter = 6, expected 6: stop only when |change| < tol (strict), "
+            "which never holds for tol = 0"
+        )
 
 
 @pytest.mark.grades("gmm_em")
@@ -1083,6 +1117,18 @@ def test_gmm_em_regularises_a_collapsing_component(impl):
 
 @pytest.mark.grades("gmm_em")
 @pytest.mark.points(1)
+def test_gmm_em_an_empty_component_and_a_falling_bound(impl):
+    # The component at 1000 gets no responsibility: N_k = 10 eps keeps its mean finite (0 / 10 eps).
+    points = np.array([[0.0], [1.0], [2.0]])
+    start = (np.array([0.5, 0.5]), np.array([[1.0], [1000.0]]), np.ones((2, 1, 1)))
+    _check_em(impl, points, start, 5, 0.0, what=" (a component with no responsibility: N_k = sum r + 10 eps)")
+    # A large reg_covar makes the bound fall: EM stops on |change| < tol, not on change < tol.
+    start = (np.array([1.0]), np.zeros((1, 1)), np.ones((1, 1, 1)))
+    _check_em(impl, np.array([[-1.0], [1.0]]), start, 10, 1e-3, 10.0, what=" (a falling bound: |change|)")
+
+
+@pytest.mark.grades("gmm_em")
+@pytest.mark.points(1)
 def test_gmm_em_never_lowers_the_likelihood(impl):
     points = _anisotropic(41, 600, columns=3)
     lower_bounds = _unpack_em(impl.gmm_em(points, *_mixture_start(points, 4, 41), 60, 0.0, 0.0), 600, 4, 3)[4]
@@ -1116,6 +1162,8 @@ def test_gmm_em_rejects_bad_arguments(impl):
     weights, means, covariances = _mixture_start(points, 3, 43)
     asymmetric = covariances.copy()
     asymmetric[0, 0, 1] += 0.5
+    nearly_symmetric = covariances.copy()
+    nearly_symmetric[1, 0, 1] += 1e-9 * np.abs(covariances[1]).max()
     cases = [
         ({"points": points[:, 0]}, "points"),
         ({"points": np.empty((0, 2))}, "points"),
@@ -1130,9 +1178,15 @@ def test_gmm_em_rejects_bad_arguments(impl):
         ({"covariances": -covariances}, "covariances"),
         ({"max_iter": 0}, "max_iter"),
         ({"max_iter": 2.5}, "max_iter"),
+        ({"max_iter": 3.0}, "max_iter"),
         ({"tol": -1.0}, "tol"),
         ({"tol": np.nan}, "tol"),
+        ({"tol": True}, "tol"),
         ({"reg_covar": -1e-6}, "reg_covar"),
+        ({"weights": weights + np.array([5e-6, 0.0, 0.0])}, "weights"),  # sums to 1 + 5e-6: not within 1e-8
+        ({"covariances": nearly_symmetric}, "covariances"),  # 1e-9 of its largest entry: not within 1e-10
+        ({"means": means.ravel()}, "means"),
+        ({"weights": np.array([1.0]), "means": means[:1], "covariances": covariances[0]}, "covariances"),  # (D, D)
     ]
     for change, name in cases:
         arguments = {"points": points, "weights": weights, "means": means, "covariances": covariances, **change}
