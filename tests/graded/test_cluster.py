@@ -22,6 +22,11 @@ EXPANDED = (
     "sum (p_j - c_j) ** 2 over the columns: |p|^2 - 2 p.c + |c|^2 loses every digit of a distance "
     "at coordinates of millions"
 )
+# What a wrong neighbourhood far from the origin most likely means.
+FAR_NEIGHBOURS = (
+    "sum (p_j - q_j) ** 2 over the columns, in float64: |p|^2 - 2 p.q + |q|^2, or any of it in float32, loses "
+    "the digits of a distance at coordinates of millions"
+)
 # Centres are means: another summation order (np.add.at, bincount, a loop) moves them by a few ulps.
 CENTRES_RTOL = 1e-12
 CENTRES_ATOL = 1e-12
@@ -700,7 +705,7 @@ def test_dbscan_far_from_the_origin(impl):
     rng = np.random.default_rng(17)
     points = np.vstack([rng.normal(c, 0.3, size=(120, 3)) for c in ([0, 0, 0], [2, 0, 0], [0, 2, 1])])
     points += [525_000.0, 4_200_000.0, 35.0]  # UTM-like coordinates, in metres
-    _check_dbscan(impl, points, 0.25, 5, what=f" far from the origin ({EXPANDED.replace('c_j', 'q_j')})")
+    _check_dbscan(impl, points, 0.25, 5, what=f" far from the origin ({FAR_NEIGHBOURS})")
 
 
 @pytest.mark.grades("dbscan")
@@ -867,7 +872,7 @@ def test_euclidean_clusters_every_column_and_far_from_the_origin(impl):
     points[:, 3:] *= rng.choice([1.0, 30.0], size=(300, 1))
     _check_components(impl, points, 1.0, what=" (5 columns)")
     far = np.vstack([rng.normal(c, 0.2, size=(100, 3)) for c in ([0, 0, 0], [2, 0, 0])]) + [525_000.0, 4.2e6, 35.0]
-    _check_components(impl, far, 0.15, 2, what=f" far from the origin ({EXPANDED.replace('c_j', 'q_j')})")
+    _check_components(impl, far, 0.15, 2, what=f" far from the origin ({FAR_NEIGHBOURS})")
 
 
 @pytest.mark.grades("euclidean_clusters")

@@ -106,12 +106,18 @@ def density(points, eps, min_samples, **flags):
     edge = ~is_core & (labels >= 0)
     if border == "noise":
         labels[edge] = -1
-    elif border in ("largest", "last_core") and edge.any():
+    elif border in ("largest", "last_core", "nearest") and edge.any():
         rows = np.flatnonzero(edge)
         for p in rows:  # each border's core neighbours, in index order
             near = _gather(indptr, indices, np.array([p]))
             near = near[is_core[near]]
-            labels[p] = labels[near].max() if border == "largest" else labels[near[-1]]
+            if border == "nearest":  # the nearest core neighbour's cluster (ties: the lowest index)
+                s = np.zeros(len(near))
+                for j in range(data.shape[1]):
+                    s += (data[near, j] - data[p, j]) ** 2
+                labels[p] = labels[near[np.argmin(s)]]
+            else:
+                labels[p] = labels[near].max() if border == "largest" else labels[near[-1]]
     numbering = flags.get("numbering", "core")
     if numbering == "first_point":  # renumbered by first appearance over every point in index order
         order = {}
@@ -163,6 +169,12 @@ DBSCAN = Model(
             "a border point touching several clusters takes the SMALLEST of their labels, the first cluster "
             "that reaches it: do not relabel a point that already has a cluster",
             _variants({"border": "largest"}, {"border": "last_core"}),
+        ),
+        Mistake(
+            "border_nearest_core",
+            "a border point touching several clusters takes the SMALLEST of their labels, not the label of its "
+            "nearest core point: the contract's rule uses no distance beyond eps",
+            _density(border="nearest"),
         ),
         Mistake(
             "border_as_noise",
