@@ -181,15 +181,16 @@ def _verdicts(model, kept, memo, mistakes, deferred=False):
     right (``("right", id(call))``). ``deferred``: the pairs :func:`_deferred` left, else the others.
     The truth of a call is computed only for a call with a verdict to find."""
     for call, arguments in kept:
-        right = memo.get(("right", id(call)))
-        if right is not None:
-            wanted = [m for m in mistakes if (id(m), id(call)) not in memo and _deferred(m, right) == deferred]
-            if not wanted:
-                continue
-        truth = _truth(model, arguments)
-        if right is None:
-            right = memo["right", id(call)] = _is_right(model, call, arguments, truth)
-            wanted = [m for m in mistakes if (id(m), id(call)) not in memo and _deferred(m, right) == deferred]
+        truth = None
+        if ("right", id(call)) not in memo:  # the first diagnosis of this call: its truth decides
+            truth = _truth(model, arguments)
+            memo["right", id(call)] = _is_right(model, call, arguments, truth)
+        right = memo["right", id(call)]
+        wanted = [m for m in mistakes if (id(m), id(call)) not in memo and _deferred(m, right) == deferred]
+        if not wanted:
+            continue
+        if truth is None:  # computed again only for a call with a verdict still to find
+            truth = _truth(model, arguments)
         for mistake in wanted:
             if truth is None:
                 memo[id(mistake), id(call)] = (NO_EVIDENCE, None)

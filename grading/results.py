@@ -55,7 +55,11 @@ def write_atomically(path, text):
             _write_all(fd, data)
         finally:
             os.close(fd)
-    os.replace(temporary, path)
+    try:
+        os.replace(temporary, path)
+    except OSError:  # the target cannot be replaced (a folder there): no whole copy left beside it
+        temporary.unlink(missing_ok=True)
+        raise
 
 
 def _linked_unnamed_file(folder, data, name):

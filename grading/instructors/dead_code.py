@@ -42,7 +42,7 @@ not run.
 import ast
 from collections import Counter
 
-__all__ = ["comparable"]
+__all__ = ["comparable", "without_texts"]
 
 DEAD_CODE_ROUNDS = 5  # passes of comparable(): a dead store feeding a dead store feeding ...
 PURITY_PASSES = 4  # a module function that only calls pure ones, down to this depth, is pure
@@ -140,16 +140,15 @@ def _literal(node):
 
 
 def _pure_call(node, callees):
-    if isinstance(node.func, ast.Lambda):  # (lambda: 2)(): the lambda's body is the call
-        callees = callees | {"<lambda>"}
-        name = "<lambda>" if _pure(node.func.body, callees) else None
+    name = _callee(node.func)
+    if isinstance(node.func, ast.Lambda):  # (lambda: 2)(): the lambda's body is what the call computes
+        known = _pure(node.func.body, callees)
     elif isinstance(node.func, ast.Attribute) and node.func.attr in PURE_METHODS:
         # points.sum(): a method that computes a value, unless the module defines one of that name.
-        name = "<method>" if f".{node.func.attr}" in callees and _pure(node.func.value, callees) else None
-        callees = callees | {"<method>"}
+        known = f".{node.func.attr}" in callees and _pure(node.func.value, callees)
     else:
-        name = _callee(node.func)
-    if name is None or any(isinstance(a, ast.Starred) for a in node.args):
+        known = name in callees
+    if not known or any(isinstance(a, ast.Starred) for a in node.args):
         return False
     keywords = {keyword.arg for keyword in node.keywords}
     if None in keywords or "out" in keywords:  # **kwargs, or a result written into an array
@@ -161,8 +160,8 @@ def _pure_call(node, callees):
         end = next((k.value for k in node.keywords if k.arg == "end"), None)
         return not node.args and keywords <= {"end", "sep", "flush"} and _literal(end) and end.value == ""
     if name in CONSUMING_BUILTINS:
-        return name in callees and all(_literal(argument) for argument in arguments)
-    return name in callees
+        return all(_literal(argument) for argument in arguments)
+    return True
 
 
 def _bound_names(tree):
@@ -447,4 +446,30 @@ def comparable(text):
                 break
         return written
     except Exception:  # whatever the parser or the writer cannot take: compared as it is
+        return text
+
+
+class _Texts(ast.NodeTransformer):
+    """Bare strings (docstrings) and asserts of constants, the statements that carry prose only."""
+
+    def visit_Expr(self, node):
+        return None if isinstance(node.value, ast.Constant) and isinstance(node.value.value, str) else node
+
+    def visit_Assert(self, node):
+        return None if _constant_truth(node.test) is True else node
+
+
+def without_texts(text):
+    """``text`` as written, less its prose: parsed and written back (comments and layout gone)
+    without bare strings and asserts of constants, and no other rule (the report's second view:
+    it keeps whatever :func:`comparable` might mistake for dead code); ``text`` itself if Python
+    cannot parse it or write it back."""
+    try:
+        tree = _Texts().visit(ast.parse(text))
+        for node in ast.walk(tree):  # a block left empty: a pass, as Python requires
+            for field in ("body", "orelse", "finalbody"):
+                if field != "orelse" and getattr(node, field, None) == [] and not isinstance(node, ast.Module):
+                    setattr(node, field, [ast.Pass()])
+        return ast.unparse(tree)
+    except Exception:
         return text

@@ -42,7 +42,7 @@ from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
 from grading.forbidden import read_source
 from grading.instructors.batch import class_folders, read_gradescope_metadata
-from grading.instructors.dead_code import comparable
+from grading.instructors.dead_code import comparable, without_texts
 from grading.instructors.gradescope import lay_over_stubs
 from grading.results import clean
 
@@ -59,9 +59,11 @@ FAMILY_SHARE = 0.8
 DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
 # Each pair is compared twice, the higher share kept: as Python reads the files (what does nothing
-# removed: a padding between the lines of a copy is gone) and as submitted (whatever the normaliser
-# mistook for dead code is there). Normalising can then only raise a share, never hide a copy.
-VIEWS = {"as Python reads them": comparable, "as submitted": str}
+# removed: a padding between the lines of a copy is gone) and as submitted (only the texts that are no
+# code removed: whatever the normaliser mistook for dead code is there). Normalising can then only
+# raise a share, never hide a copy; and prose two students both pasted (a docstring, an assert's
+# message) raises neither view (h49f: a shared paragraph took two independent files to 38-42 %).
+VIEWS = {"as Python reads them": comparable, "as submitted": without_texts}
 
 
 @dataclass(frozen=True)
@@ -325,7 +327,8 @@ The share is the part of a student's file (stub text removed, names folded) that
 Each pair is compared twice, and the higher share kept and shown: as Python reads the files (comments and
 layout gone, and the statements that do nothing removed: <code>pass</code>, an expression without a call, a
 docstring, unreachable code, a store into a name nothing reads: <code>grading/instructors/dead_code.py</code>),
-and as submitted; each pair says which. Read the submitted files themselves too.
+and as submitted (less docstrings, bare strings and asserts of constants); each pair says which.
+Read the submitted files themselves too.
 A high share is a reason to read both files, not a verdict.</p>
 {f"<ul>{notes}</ul>" if notes else ""}
 <table><thead><tr><th>#</th><th>module</th><th>student</th><th>student</th>

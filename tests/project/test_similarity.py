@@ -391,3 +391,20 @@ def test_a_normaliser_that_drops_code_cannot_hide_a_copy(monkeypatch, tmp_path):
     assert {pairs[0].first, pairs[0].second} == {"alice", "bob"} and pairs[0].similarity > 0.9, pairs[0]
     assert pairs[0].view == "as submitted"
     assert all(p.similarity < DISPLAY_THRESHOLD for p in pairs[1:])
+
+
+@pytest.mark.parametrize("prose", ["docstring", "assert"])
+def test_prose_two_students_pasted_raises_no_pair(prose, tmp_path):
+    """A hostile review (h49f): the same lecture-notes paragraph at the top of two independent files,
+    as a docstring or an assert's message, took them to 38-42 % in the view as submitted."""
+    note = (
+        "Notes from the lecture: the principal components are the eigenvectors of the covariance matrix of the "
+        "centred points, sorted by decreasing eigenvalue; with correlation each column is first divided by its "
+        "standard deviation so that every coordinate counts the same; a constant column is left at zero."
+    )
+    header = f'"""{note}"""\n' if prose == "docstring" else f'assert True, "{note}"\n'
+    for name, body in (("alice", ALICE), ("carol", header + textwrap.dedent(CAROL).strip()),
+                       ("dave", header + textwrap.dedent(DAVE).strip())):  # fmt: skip
+        student(tmp_path, name, body)
+    pairs, _ = compare_class(tmp_path)
+    assert all(p.similarity < DISPLAY_THRESHOLD for p in pairs), [(p.first, p.second, p.similarity) for p in pairs]
