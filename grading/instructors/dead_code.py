@@ -14,7 +14,7 @@ gone. What it drops:
   displays of them, ``a if t else b``, f-strings, comprehensions over
   literals; a docstring too; calls of pure functions,
   :func:`_pure_callees`: ``abs(0)``, ``len(points)``, ``np.sqrt(x)``
-  without ``out=``, a module function that only returns a pure value, a
+  without ``out``, by keyword or by position, a module function that only returns a pure value, a
   lambda called at once, an array method that computes a value,
   ``points.sum()``, :data:`PURE_METHODS`);
   ``assert`` on a true constant; ``global`` and ``nonlocal``;
@@ -40,7 +40,10 @@ not run.
 """
 
 import ast
+import inspect
 from collections import Counter
+
+import numpy as np
 
 __all__ = ["comparable", "without_texts"]
 
@@ -72,6 +75,30 @@ PURE_NUMPY = frozenset(
     "isnan linspace log matmul max maximum mean min minimum ndim ones ones_like round shape sin size "
     "sort sqrt square stack std sum var vstack where zeros zeros_like".split()
 )
+
+
+def _arguments_before_out(name):
+    """How many positional arguments NumPy's ``name`` takes before ``out`` (a ufunc's ``nin``; the
+    place of ``out`` in its signature), or None if it has no ``out``: ``np.exp(x, y)`` writes y."""
+    function = getattr(np, name, None)
+    if function is None:
+        return None
+    if isinstance(function, np.ufunc):
+        return function.nin
+    try:
+        parameters = list(inspect.signature(function).parameters)
+    except (TypeError, ValueError):  # no signature to read: any positional argument may be ``out``
+        return 0
+    return parameters.index("out") if "out" in parameters else None
+
+
+# Derived from NumPy, not listed: a call with more positional arguments than these writes into one.
+NUMPY_BEFORE_OUT = {name: _arguments_before_out(name) for name in PURE_NUMPY}
+# The methods take the array as self: ``points.sum(0, None, buffer)`` writes into buffer.
+METHOD_BEFORE_OUT = {
+    name: None if _arguments_before_out(name) is None else max(_arguments_before_out(name) - 1, 0)
+    for name in PURE_METHODS
+}
 
 
 def _pure(node, callees=frozenset()):
@@ -149,6 +176,12 @@ def _pure_call(node, callees):
     else:
         known = name in callees
     if not known or any(isinstance(a, ast.Starred) for a in node.args):
+        return False
+    if isinstance(node.func, ast.Attribute) and node.func.attr in PURE_METHODS and name not in callees:
+        before_out = METHOD_BEFORE_OUT[node.func.attr]
+    else:  # a dotted pure callee is NumPy's (the module's own functions and the builtins are plain names)
+        before_out = NUMPY_BEFORE_OUT.get(name.rpartition(".")[2]) if name and "." in name else None
+    if before_out is not None and len(node.args) > before_out:  # an ``out`` passed by position
         return False
     keywords = {keyword.arg for keyword in node.keywords}
     if None in keywords or "out" in keywords:  # **kwargs, or a result written into an array

@@ -181,6 +181,9 @@ def test_statements_that_do_nothing_hide_no_copy(padding, tmp_path):
     [
         "def abs(x):\n    print(x)\n\ndef f():\n    abs(0)",  # a builtin's name bound by the module
         "import numpy as np\n\ndef f(p):\n    np.sqrt(p, out=p)",  # written into an array
+        "import numpy as np\n\ndef f(p, q):\n    np.maximum(p, 0, q)",  # out by position, a ufunc
+        "import numpy as np\n\ndef f(p, q):\n    np.cumsum(p, 0, None, q)",  # out by position
+        "def f(points, total):\n    points.sum(0, None, total)",  # a method's out by position
         "def f(it):\n    list(it)",  # an iterator used up
         "def f():\n    print('x')",
         "def _log(x):\n    print(x)\n    return x\n\ndef f():\n    _log(1)",  # a function with an effect
