@@ -27,14 +27,16 @@ def euclidean_clusters(
     order="largest first",
     strict_sizes=False,
     number_before_filter=False,
+    root=False,
 ):
     """The contract's clusters with the mutants' switches (the defaults are the contract's).
 
     ``linked="<"``: points exactly ``tolerance`` apart are not linked;
     ``squared=False``: ``s <= tolerance`` (the tolerance not squared);
     ``columns``: the distance over the first ones only; ``order``:
-    ``"largest first"``, ``"smallest first"`` or ``"by index"`` (the
-    components' own order, as found); ``strict_sizes``: a cluster kept only
+    ``"largest first"``, ``"smallest first"``, ``"by index"`` (the
+    components' own order, as found) or ``"argsort"`` (numpy's default,
+    unstable argsort of the negated sizes); ``root``: ``sqrt(s) <= tolerance``; ``strict_sizes``: a cluster kept only
     if ``min_size < size < max_size``; ``number_before_filter``: every
     component numbered, then the dropped ones set to -1 (gaps in the labels).
     """
@@ -53,7 +55,10 @@ def euclidean_clusters(
             s = np.zeros(len(x))
             for j in range(width):
                 s += (x[:, j] - x[p, j]) ** 2
-            near = s < limit if linked == "<" else s <= limit
+            if root:
+                near = np.sqrt(s) <= tolerance
+            else:
+                near = s < limit if linked == "<" else s <= limit
             for q in np.flatnonzero(near & ~visited):
                 visited[q] = True
                 members.append(q)
@@ -68,6 +73,10 @@ def euclidean_clusters(
         numbered = sorted(numbered, key=lambda i: (-len(found[i]), i))
     elif order == "smallest first":
         numbered = sorted(numbered, key=lambda i: (len(found[i]), i))
+    elif order == "argsort":
+        numbered = list(numbered)
+        sizes = np.array([len(found[i]) for i in numbered], dtype=np.int64)
+        numbered = [numbered[i] for i in np.argsort(-sizes)]
     labels = np.full(len(x), -1, dtype=np.int64)
     for label, i in enumerate(numbered):
         if keep[i]:

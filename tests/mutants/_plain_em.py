@@ -61,6 +61,7 @@ def gmm_em(
     bound_after_m_step=False,
     relative_tol=False,
     final_e_step=True,
+    stop_before_m_step=False,
 ):
     """EM with the mutants' switches (the defaults are the contract's)."""
     x = np.asarray(points, dtype=float)
@@ -73,6 +74,8 @@ def gmm_em(
         log_likelihood, r = _e_step(x, weights, means, covariances, log_domain, diagonal)
         if not bound_after_m_step:
             bounds.append(log_likelihood.mean() if bound == "mean" else log_likelihood.sum())
+        if stop_before_m_step and t > 1 and abs(bounds[-1] - bounds[-2]) < tol:
+            break
         n_k = r.sum(axis=0) + 10 * np.finfo(float).eps
         new_means = (r.T @ x) / n_k[:, None]
         for k in range(len(n_k)):

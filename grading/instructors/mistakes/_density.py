@@ -51,6 +51,8 @@ def _neighbourhoods(data, eps, radius="inclusive", columns=None, zero=True):
             near = s <= eps
         elif radius == "root_against_squared":  # a distance against eps ** 2
             near = np.sqrt(s) <= eps * eps
+        elif radius == "root":  # the distance against eps: the contract's rule, rounded otherwise
+            near = np.sqrt(s) <= eps
         else:
             near = s <= eps * eps
         if not zero:  # a mistake's 0 < s: the point itself and its duplicates dropped
@@ -106,7 +108,7 @@ def density(points, eps, min_samples, **flags):
     edge = ~is_core & (labels >= 0)
     if border == "noise":
         labels[edge] = -1
-    elif border in ("largest", "last_core", "nearest") and edge.any():
+    elif border in ("largest", "last_core", "lowest_core", "nearest") and edge.any():
         rows = np.flatnonzero(edge)
         for p in rows:  # each border's core neighbours, in index order
             near = _gather(indptr, indices, np.array([p]))
@@ -116,6 +118,8 @@ def density(points, eps, min_samples, **flags):
                 for j in range(data.shape[1]):
                     s += (data[near, j] - data[p, j]) ** 2
                 labels[p] = labels[near[np.argmin(s)]]
+            elif border == "lowest_core":
+                labels[p] = labels[near[0]]
             else:
                 labels[p] = labels[near].max() if border == "largest" else labels[near[-1]]
     numbering = flags.get("numbering", "core")
@@ -153,6 +157,12 @@ DBSCAN = Model(
             _variants({"radius": "unsquared_eps"}, {"radius": "root_against_squared"}),
         ),
         Mistake(
+            "root_against_eps",
+            "compare the squared distance with eps ** 2 (s <= eps * eps), as the contract does: sqrt(s) <= eps "
+            "is the same rule in exact arithmetic, but it rounds otherwise for a pair eps apart to the last digit",
+            _density(radius="root"),
+        ),
+        Mistake(
             "min_samples_off_by_one",
             "p is core iff |N(p)| >= min_samples, with p itself counted in N(p): yours needs one point more "
             "(it counts only the other points, or takes > min_samples)",
@@ -175,6 +185,12 @@ DBSCAN = Model(
             "a border point touching several clusters takes the SMALLEST of their labels, not the label of its "
             "nearest core point: the contract's rule uses no distance beyond eps",
             _density(border="nearest"),
+        ),
+        Mistake(
+            "border_lowest_core",
+            "a border point touching several clusters takes the SMALLEST of their labels, not the label of its "
+            "lowest-index core neighbour: clusters are numbered by their smallest core, which need not be it",
+            _density(border="lowest_core"),
         ),
         Mistake(
             "border_as_noise",
@@ -254,6 +270,10 @@ def components(points, tolerance, min_size=1, max_size=None, **flags):
         numbered = numbered[np.argsort(-sizes[numbered], kind="stable")]
     elif order == "smallest first":
         numbered = numbered[np.argsort(sizes[numbered], kind="stable")]
+    elif order == "unstable":  # numpy's default sort: equal sizes in no stated order
+        numbered = numbered[np.argsort(-sizes[numbered])]
+    elif order == "reversed":  # increasing sizes read backwards: equal sizes by their largest index
+        numbered = numbered[np.argsort(sizes[numbered], kind="stable")[::-1]]
     label = np.full(len(roots), -1, dtype=np.int64)
     label[numbered] = np.arange(len(numbered))
     label[~keep] = -1
@@ -263,6 +283,12 @@ def components(points, tolerance, min_size=1, max_size=None, **flags):
 def _components(**flags):
     return lambda points, tolerance, min_size=1, max_size=None: components(
         points, tolerance, min_size, max_size, **flags
+    )
+
+
+def _component_variants(*flag_sets):
+    return lambda points, tolerance, min_size=1, max_size=None: Variants(
+        components(points, tolerance, min_size, max_size, **flags) for flags in flag_sets
     )
 
 
@@ -297,6 +323,20 @@ EUCLIDEAN_CLUSTERS = Model(
             "number the kept clusters by DECREASING size: the largest cluster is 0 (sort by -size, then by the "
             "smallest point index)",
             _components(order="smallest first"),
+        ),
+        Mistake(
+            "size_ties_unordered",
+            "number equal-sized clusters by their smallest point index: np.argsort(-sizes) is not stable (use "
+            'kind="stable", or sort on (-size, smallest index)), and a reversed ascending sort puts the largest '
+            "index first",
+            _component_variants({"order": "unstable"}, {"order": "reversed"}),
+        ),
+        Mistake(
+            "root_against_tolerance",
+            "compare the squared distance with tolerance ** 2 (s <= tolerance * tolerance), as the contract does: "
+            "sqrt(s) <= tolerance is the same rule in exact arithmetic, but rounds otherwise for a pair the "
+            "tolerance apart to the last digit",
+            _components(radius="root"),
         ),
         Mistake(
             "strict_sizes",

@@ -169,6 +169,9 @@ def em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e
             r, total = _e_step(data, weights, means, covariances, **densities)
             if flags.get("bound") != "after_m_step":
                 bounds.append(float(record(total)))
+            if flags.get("stop_before_m_step") and t > 1 and _stops(bounds, tol, "absolute"):
+                last_r = r
+                break
             last_r = r
             new_weights, means, covariances = _m_step(
                 data, r, means, reg_covar, scatter, divisor, flags.get("reg", True)
@@ -366,6 +369,13 @@ GMM_EM = Model(
             "stop when |lower_bounds[t - 1] - lower_bounds[t - 2]| < tol: tol is an absolute change of the mean "
             "log-likelihood, not a fraction of the bound",
             _mistake({"stop": "relative_current"}, {"stop": "relative_previous"}),
+        ),
+        Mistake(
+            "stop_before_m_step",
+            "test the stop after the M-step: iteration t runs its E-step, then its M-step, then compares "
+            "lower_bounds[t - 1] with lower_bounds[t - 2]; stopping right after the E-step returns parameters one "
+            "M-step short",
+            _mistake({"stop_before_m_step": True}),
         ),
         Mistake(
             "stale_responsibilities",
