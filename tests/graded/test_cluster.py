@@ -16,6 +16,7 @@ from sklearn.cluster import KMeans
 from sklearn.datasets import make_blobs
 
 from grading.checks import CheckFailed, as_list, check_array, check_close, check_unmodified, raises
+from grading.checks.cluster import linked_components, lloyd, nearest_centres, scikit_learn_em
 
 # What a wrong answer far from the origin most likely means.
 EXPANDED = (
@@ -60,31 +61,9 @@ def _unpack(result, n, k, d):
     return labels, centers, inertia, int(n_iter)
 
 
-def _nearest(points, centers):
-    """Each point's nearest centre by the contract's squared distance, ties to the lowest index."""
-    s = sum((points[:, j, None] - centers[None, :, j]) ** 2 for j in range(points.shape[1]))
-    return np.argmin(s, axis=1), s
-
-
-def _lloyd(points, centers, max_iter=300):
-    """The contract's iterations, written here: labels, centres, inertia list, n_iter."""
-    centers = np.array(centers, dtype=float)
-    previous, inertia = None, []
-    for t in range(1, max_iter + 1):
-        labels, s = _nearest(points, centers)
-        inertia.append(float(s[np.arange(len(points)), labels].sum()))
-        if previous is not None and np.array_equal(labels, previous):
-            return labels, centers, inertia, t
-        for c in range(len(centers)):
-            if np.any(labels == c):
-                centers[c] = points[labels == c].mean(axis=0)
-        previous = labels
-    return _nearest(points, centers)[0], centers, inertia, max_iter
-
-
 def _check_run(impl, points, start, max_iter=300, what=""):
-    """``kmeans`` from ``start`` against :func:`_lloyd`: labels, centres, n_iter and inertia."""
-    expected = _lloyd(points, start, max_iter)
+    """``kmeans`` from ``start`` against :func:`lloyd`: labels, centres, n_iter and inertia."""
+    expected = lloyd(points, start, max_iter)
     labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start, max_iter), *points.shape[:1], *start.shape)
     _check_labels(labels, expected[0], what)
     scale = float(np.abs(points).max())
@@ -160,9 +139,9 @@ def test_kmeans_truncated_runs_are_the_first_iterations(impl):
     assert full[3] > 3, f"this cloud takes more than 3 iterations, got n_iter = {full[3]}"
     centers = start.copy()
     for t in (1, 2, 3):
-        labels, _ = _nearest(points, centers)
+        labels, _ = nearest_centres(points, centers)
         centers = np.array([points[labels == c].mean(axis=0) for c in range(6)])  # no cluster empties here
-        expected_labels, _ = _nearest(points, centers)
+        expected_labels, _ = nearest_centres(points, centers)
         got = _unpack(impl.kmeans(points, start, max_iter=t), len(points), 6, 2)
         assert got[3] == t, f"max_iter = {t}: n_iter must be {t}, got {got[3]}"
         check_close(got[2], full[2][:t], f"inertia with max_iter = {t}", rtol=1e-12)
@@ -229,7 +208,7 @@ def test_kmeans_the_final_state_is_a_fixed_point(impl):
     start = points[[0, 1, 2, 3, 4]].copy()  # five centres from one blob
     labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start), len(points), 5, 3)
     assert n_iter < 300, f"n_iter is {n_iter}: this cloud converges well before 300 (stop when no label changes)"
-    nearest, s = _nearest(points, centers)
+    nearest, s = nearest_centres(points, centers)
     _check_labels(labels, nearest, " (each point's nearest returned centre)")
     for c in np.unique(labels):
         check_close(
@@ -751,23 +730,6 @@ def test_dbscan_rejects_bad_arguments(impl):
 # --- euclidean_clusters ----------------------------------------------------------------
 
 
-def linked_components(points, tolerance, min_size=1, max_size=None):
-    """The contract's answer, from its rules: SciPy's connected components of the links s <= tolerance^2,
-    components outside the sizes dropped, the rest numbered by decreasing size, then smallest index."""
-    from scipy.sparse import csr_array
-    from scipy.sparse.csgraph import connected_components
-
-    points = np.asarray(points, dtype=float)
-    s = sum((points[:, j, None] - points[None, :, j]) ** 2 for j in range(points.shape[1]))
-    _, component = connected_components(csr_array(s <= tolerance * tolerance), directed=False)
-    labels = np.full(len(points), -1, dtype=np.int64)
-    members = [np.flatnonzero(component == c) for c in range(component.max(initial=-1) + 1)]
-    kept = [m for m in members if min_size <= len(m) <= (len(points) if max_size is None else max_size)]
-    for label, m in enumerate(sorted(kept, key=lambda m: (-len(m), m[0]))):
-        labels[m] = label
-    return labels
-
-
 def _check_components(impl, points, tolerance, min_size=1, max_size=None, expected=None, what=""):
     labels = impl.euclidean_clusters(points, tolerance, min_size, max_size)
     check_array(labels, "labels", shape=(len(points),), dtype="int64")
@@ -935,32 +897,6 @@ def _mixture_start(points, k, seed):
     return weights, means, covariances
 
 
-def _scikit_learn_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_covar=1e-6):
-    """scikit-learn's GaussianMixture from the same parameters: the contract's rules."""
-    import warnings
-
-    from sklearn.mixture import GaussianMixture
-
-    fitted = GaussianMixture(
-        len(weights),
-        covariance_type="full",
-        tol=tol,
-        reg_covar=reg_covar,
-        max_iter=max_iter,
-        weights_init=weights,
-        means_init=means,
-        precisions_init=np.linalg.inv(covariances),
-        init_params="random_from_data",
-        random_state=0,
-    )
-    with warnings.catch_warnings():  # "did not converge": a truncated run is the point here
-        warnings.simplefilter("ignore")
-        fitted.fit(points)
-    lower_bounds = np.array(fitted.lower_bounds_)
-    parameters = (fitted.weights_, fitted.means_, fitted.covariances_)
-    return (*parameters, fitted.predict_proba(points), lower_bounds, fitted.n_iter_)
-
-
 def _unpack_em(result, n, k, d):
     if not isinstance(result, tuple) or len(result) != 6:
         raise CheckFailed(
@@ -988,7 +924,7 @@ def _check_em(impl, points, start, max_iter=100, tol=1e-3, reg_covar=1e-6, expec
     n, d = points.shape
     k = len(start[0])
     result = _unpack_em(impl.gmm_em(points, *start, max_iter, tol, reg_covar), n, k, d)
-    expected = _scikit_learn_em(points, *start, max_iter, tol, reg_covar) if expected is None else expected
+    expected = scikit_learn_em(points, *start, max_iter, tol, reg_covar) if expected is None else expected
     lower_bounds, n_iter = result[4], result[5]
     steps = min(n_iter, expected[5])
     check_close(
@@ -1089,7 +1025,7 @@ def test_gmm_em_stops_at_the_first_small_change(impl):
     # tol between two consecutive changes of the bound: EM stops exactly after the smaller one.
     points = _anisotropic(38, 600)
     start = _mixture_start(points, 3, 38)
-    bounds = _scikit_learn_em(points, *start, 40, 0.0)[4]
+    bounds = scikit_learn_em(points, *start, 40, 0.0)[4]
     changes = np.abs(np.diff(bounds))  # changes[i]: between iterations i + 1 and i + 2
     t = next(i for i in range(2, len(changes)) if changes[i] < changes[:i].min() * 0.5)
     tol = float(np.sqrt(changes[t] * changes[:t].min()))  # every earlier change > tol > changes[t]
