@@ -53,6 +53,9 @@ def write_atomically(path, text):
         fd = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         try:
             _write_all(fd, data)
+        except BaseException:  # interrupted (a signal's exception, a full disk): no half file left
+            temporary.unlink(missing_ok=True)
+            raise
         finally:
             os.close(fd)
     try:

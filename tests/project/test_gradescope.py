@@ -373,3 +373,14 @@ def test_results_are_written_whole_and_leave_nothing_beside_them(tmp_path, monke
         results.write_atomically(target, text)
     assert target.read_text() == '{"score": 1}' and stat.S_IMODE(target.stat().st_mode) == 0o600
     assert [p.name for p in target.parent.iterdir()] == ["results.json"]
+
+    # Interrupted half-way through the text (a signal's exception): the old file stays, whole, alone.
+    def half_then_killed(fd, data):
+        os.write(fd, data[: len(data) // 2])
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(results, "_write_all", half_then_killed)
+    with pytest.raises(KeyboardInterrupt):
+        results.write_atomically(target, '{"score": 2, "tests": []}')
+    assert target.read_text() == '{"score": 1}'
+    assert [p.name for p in target.parent.iterdir()] == ["results.json"]
