@@ -49,6 +49,7 @@ __all__ = [
     "density_panels",
     "k_distance_curve",
     "clusters_top_view",
+    "mixture_iterations",
 ]
 
 
@@ -1397,5 +1398,89 @@ def clusters_top_view(panels, figsize=(11, 8), xlim=(-40, 40), ylim=(-14, 14), s
         order = np.argsort(labels >= 0, kind="stable")  # noise first, under the clusters
         ax.scatter(*points[order, :2].T, s=size, c=_cluster_colours(labels[order]), lw=0)
         ax.set(title=title, xlim=xlim, ylim=ylim, aspect="equal", xlabel="x (m)", ylabel="y (m)")
+    fig.tight_layout()
+    plt.show()
+
+
+def _covariance_ellipse(ax, mean, covariance, scale, colour, **kwargs):
+    """Draw the ellipse of the points at Mahalanobis distance ``scale`` from ``mean`` (2-D)."""
+    from matplotlib.patches import Ellipse
+
+    values, vectors = np.linalg.eigh(np.asarray(covariance, dtype=float))
+    angle = np.degrees(np.arctan2(vectors[1, 1], vectors[0, 1]))  # the major axis: the last eigenvector
+    width, height = 2 * scale * np.sqrt(np.maximum(values[::-1], 0.0))
+    ax.add_patch(Ellipse(mean, width, height, angle=angle, fill=False, ec=colour, **kwargs))
+
+
+def mixture_iterations(points, panels, lower_bounds=None, final_bound=None, marks=(), columns=2, figsize=(11, 6.4)):
+    """A 2-D Gaussian mixture at a few iterations of EM, beside how far each recorded bound is from the last.
+
+    Each panel shows the points, coloured by the component of largest responsibility, and every
+    component's ellipses at one and two standard deviations (the points at Mahalanobis distance 1
+    and 2 from its mean), with its mean as a cross. If ``lower_bounds`` is given, the last column
+    plots, on a log scale, how far the bound recorded after t iterations lies below ``final_bound``.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2) or None
+        The points of every panel; ``None`` if each panel brings its own.
+    panels : dict of str to tuple
+        Title -> (means (K, 2), covariances (K, 2, 2) or ``None``: no ellipses, responsibilities
+        (N, K) or ``None``: the points are drawn grey), optionally followed by the panel's own
+        points (N, 2).
+    lower_bounds : array_like of shape (T,), optional
+        The average log-likelihood recorded at each iteration's E-step: ``lower_bounds[t]`` is that
+        of the parameters after ``t`` iterations, ``t = 0 .. T - 1``. Default: no curve.
+    final_bound : float, optional
+        The average log-likelihood of the returned parameters, above every recorded bound; needed
+        with ``lower_bounds``.
+    marks : sequence of int, default ()
+        Numbers of iterations done (``0 .. T - 1``) to mark on the curve, e.g. those the panels show.
+    columns : int, default 2
+        Panels per row; the curve, if any, takes one more column, over all the rows.
+    figsize : tuple of float, default (11, 6.4)
+    """
+    import matplotlib.pyplot as plt
+
+    if not panels:
+        raise ValueError("panels: nothing to draw")  # before a figure exists: no empty figure is shown
+    rows = -(-len(panels) // columns)
+    fig = plt.figure(figsize=figsize)
+    curved = lower_bounds is not None
+    grid = fig.add_gridspec(rows, columns + curved, width_ratios=[1] * columns + [1.25] * curved)
+    for j, (title, (means, covariances, responsibilities, *own)) in enumerate(panels.items()):
+        ax = fig.add_subplot(grid[j // columns, j % columns])
+        cloud = np.asarray(own[0] if own else points, dtype=float)
+        low, high = cloud.min(axis=0), cloud.max(axis=0)
+        margin = 0.05 * (high - low)
+        means = np.asarray(means, dtype=float)
+        if responsibilities is None:
+            colours = "0.6"
+        else:
+            colours = [f"C{k % 10}" for k in np.argmax(np.asarray(responsibilities), axis=1)]
+        ax.scatter(cloud[:, 0], cloud[:, 1], s=3, c=colours, alpha=0.4, lw=0)
+        for k, mean in enumerate(means):
+            if covariances is not None:
+                for scale, style in ((1, "-"), (2, "--")):
+                    _covariance_ellipse(ax, mean, np.asarray(covariances, dtype=float)[k], scale, "k", lw=1.2, ls=style)
+            ax.plot(*mean, marker="X", ms=9, c=f"C{k % 10}", mec="k")
+        ax.set(title=title, aspect="equal", xlim=(low[0] - margin[0], high[0] + margin[0]),
+               ylim=(low[1] - margin[1], high[1] + margin[1]))  # fmt: skip
+        ax.tick_params(labelsize=8)
+    if curved:
+        gaps = float(final_bound) - np.asarray(lower_bounds, dtype=float)
+        curve = fig.add_subplot(grid[:, columns])
+        done = np.arange(len(gaps))
+        curve.plot(done, gaps, marker="o", ms=3, c="k", lw=1.2)
+        shown = [t for t in marks if 0 <= t < len(gaps)]
+        if shown:
+            curve.plot(shown, gaps[np.array(shown)], ls="none", marker="o", ms=9, mfc="none", mec="C3",
+                       label="the parameters drawn")  # fmt: skip
+            curve.legend(loc="upper right", fontsize=8)
+        curve.set(yscale="log", xlabel="iterations done",
+                  ylabel="log-likelihood of the returned parameters\nminus the bound recorded",
+                  title="recorded bounds below the\nreturned parameters' log-likelihood")  # fmt: skip
+        curve.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
+        curve.grid(alpha=0.3, which="both")
     fig.tight_layout()
     plt.show()
