@@ -50,6 +50,7 @@ __all__ = [
     "k_distance_curve",
     "clusters_top_view",
     "mixture_iterations",
+    "clustering_grid",
 ]
 
 
@@ -1482,5 +1483,43 @@ def mixture_iterations(points, panels, lower_bounds=None, final_bound=None, mark
                   title="recorded bounds below the\nreturned parameters' log-likelihood")  # fmt: skip
         curve.xaxis.set_major_locator(plt.MaxNLocator(integer=True))
         curve.grid(alpha=0.3, which="both")
+    fig.tight_layout()
+    plt.show()
+
+
+def clustering_grid(clouds, results, figsize=(14, 14.5)):
+    """2-D clouds clustered by several methods: one row per cloud, one column per method.
+
+    Each panel colours the points by their label (``C0`` to ``C9``, cycling; noise, -1, black) and
+    says, under it, the adjusted Rand index and the wall time of its run.
+
+    Parameters
+    ----------
+    clouds : dict of str to array_like of shape (N, 2)
+        Row title -> the points of that row.
+    results : dict of (str, str) to (array_like of shape (N,), float, float)
+        (row title, column title) -> the labels, the wall time in seconds and the adjusted Rand
+        index. The columns are in the order in which they first appear; every row needs every column.
+    figsize : tuple of float, default (14, 14.5)
+    """
+    import matplotlib.pyplot as plt
+
+    if not clouds or not results:
+        raise ValueError("clouds, results: nothing to draw")  # before a figure exists: no empty figure is shown
+    columns = list(dict.fromkeys(column for _, column in results))
+    panels = [[results[row, column] for column in columns] for row in clouds]  # all there, before a figure
+    fig, axes = plt.subplots(len(clouds), len(columns), figsize=figsize, squeeze=False)
+    for axes_row, points, shown in zip(axes, clouds.values(), panels):
+        points = np.asarray(points, dtype=float)
+        for ax, (labels, seconds, score) in zip(axes_row, shown):
+            colours = ["k" if label < 0 else f"C{label % 10}" for label in np.asarray(labels)]
+            ax.scatter(points[:, 0], points[:, 1], s=3, c=colours, lw=0)
+            milliseconds = f"{seconds * 1e3:.1f}" if seconds < 0.01 else f"{seconds * 1e3:.0f}"
+            ax.set(xticks=[], yticks=[], aspect="equal", adjustable="datalim")
+            ax.set_xlabel(f"ARI {score:.2f}, {milliseconds} ms", fontsize=9)
+    for ax, row in zip(axes[:, 0], clouds):
+        ax.set_ylabel(row, fontsize=10)
+    for ax, column in zip(axes[0], columns):
+        ax.set_title(column, fontsize=10)
     fig.tight_layout()
     plt.show()
