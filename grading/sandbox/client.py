@@ -243,11 +243,12 @@ class Worker:
         The arguments here are never changed: the function works on copies
         in memory the grader shares with the worker (a memfd), which the
         grader reads back itself. Returns the answer; :attr:`last_modified`
-        then holds the paths of the arguments the call modified in place
-        (``["args", 0]`` is the first positional one, ``["kwargs", "name"]``
-        a keyword one), arrays by the grader's own reading, random
-        generators by the state they came back in. A random generator among
-        the arguments draws on from where the call left it.
+        then holds the paths of the array arguments the call modified in
+        place (``["args", 0]`` is the first positional one,
+        ``["kwargs", "name"]`` a keyword one), by the grader's own reading.
+        A random generator among the arguments draws on from where the call
+        left it, as it does in-process: drawing from it is its use, not a
+        change of an input (a function of ``rng`` must draw).
         """
         self.last_modified = []
         if module in self.broken:
@@ -349,7 +350,8 @@ class Worker:
             raise SandboxError(self.broken[module], kind=IMPORT)
         answer = self._read_header(deadline)
         arrays = self._read_arrays(answer.get("arrays", []), deadline)
-        self.last_modified = _modified_paths(arguments, answer.get("modified", [])) + self._changed_in_place(shared)
+        _advance_generators(arguments, answer.get("modified", []))
+        self.last_modified = self._changed_in_place(shared)
         if answer.get("ok") is not True:
             if not isinstance(answer.get("type"), str):
                 raise SandboxError("the worker's answer was garbled", kind=GARBLED)
@@ -491,10 +493,10 @@ def _layout(arguments):
     return shared, size
 
 
-def _modified_paths(arguments, modified):
-    """The paths of the random generators the call drew from, as the worker names them, each
-    given the new state the worker sent (checked: one its own stream reaches). Arrays are not
-    the worker's to report (:meth:`Worker._changed_in_place`)."""
+def _advance_generators(arguments, modified):
+    """Give each random generator the call drew from, as the worker names them, the new state the
+    worker sent (checked: one its own stream reaches); their paths. Arrays are not the worker's to
+    report (:meth:`Worker._changed_in_place`)."""
     if not isinstance(modified, list) or len(modified) > config.MAX_ARRAYS:
         raise SandboxError("the worker's answer was garbled", kind=GARBLED)
     paths = []

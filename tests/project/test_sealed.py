@@ -151,6 +151,30 @@ def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     assert cheat["score"] < honest["score"] < honest["max_score"]
 
 
+def _draws_from_rng(function):
+    import importlib
+    import inspect
+
+    stub = getattr(importlib.import_module(f"pcl_course.{GRADED_FUNCTIONS[function]}"), function)
+    return "rng" in inspect.signature(stub).parameters
+
+
+def test_drawing_from_the_callers_generator_is_no_mistake_in_the_sandbox(tmp_path):
+    """The reference's functions of ``rng``, graded in the sandbox with the catalogue tried on every
+    function: no diagnosis. (The sandbox once reported each draw as an input modified in place, so
+    that every wrong answer of those functions read "changed its input array in place", where the
+    mutants, graded in-process, never did.)"""
+    functions = [f for f in GRADED_FUNCTIONS if _draws_from_rng(f)]
+    assert "kmeans_plusplus" in functions
+    submission = tmp_path / "clone"
+    reference_package(submission / "pcl_course")
+    selected = [option for f in functions for option in ("--function", f)]
+    summary, _ = run_grader(str(submission), "--diagnose-always", *selected, tmp_path=tmp_path)
+    assert summary["grading"].isolation.startswith("isolated")
+    assert summary["score"] == summary["max_score"] > 0
+    assert summary["extra_data"]["all_diagnoses"] == {}, summary["extra_data"]["all_diagnoses"]
+
+
 GENERATORS = """
 import numpy as np
 
@@ -177,6 +201,10 @@ def test_a_generator_comes_back_only_on_its_own_stream(tmp_path, level):
     try:
         rng, twin = np.random.default_rng(5), np.random.default_rng(5)
         first = worker.call("evil", "advance", (rng,), {})
+        # Drawing is the generator's use, not a change of an input: no in-place verdict (helper h53
+        # found the sandbox naming it one, so kmeans_plusplus' every wrong answer read "changed its
+        # input array in place", which the in-process grading of the mutants never showed).
+        assert worker.last_modified == []
         assert np.array_equal(first, twin.integers(0, 1000, size=5))
         # The generator drew on in the worker, and draws on here from where it was left.
         assert np.array_equal(rng.integers(0, 1000, size=5), twin.integers(0, 1000, size=5))
