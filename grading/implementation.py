@@ -55,6 +55,12 @@ def _private_copy(value):
     return value
 
 
+def _first_line(text, limit=200):
+    """The first line of ``str(text)``, at most ``limit`` characters: what a one-line diagnosis may quote
+    of an exception's message or place (both the submission's)."""
+    return (str(text).splitlines() or [""])[0][:limit]
+
+
 def _modified(before, after, path=()):
     """Paths of the arrays of ``after`` that differ from those of ``before`` (same structure)."""
     if type(before) is np.ndarray:
@@ -241,9 +247,9 @@ class Implementation:
                 raise NotImplementedYet(name) from None
             except Exception as exc:
                 call.error_type = type(exc).__name__
-                call.error = (str(exc).splitlines() or [""])[0][:200]
+                call.error = _first_line(exc)
                 where, own = _origin(exc, self)
-                call.where = getattr(exc, "where", None) or where
+                call.where = _first_line(getattr(exc, "where", None) or where)  # a file name the submission chose
                 if not hasattr(exc, "raised_by_submission"):
                     exc.raised_by_submission = own
                 modified = getattr(exc, "modified", [])

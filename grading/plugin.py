@@ -201,7 +201,7 @@ def _run_diagnosis(config, function, tests, always, memo):
     if found is None:
         return None
     failed = [t for t, o in tests.items() if not o.passed]
-    line = clean(diagnosis.explained_line(found, len(failed)))
+    line = clean(diagnosis.explained_line(found, len(failed)), newlines=False)  # one line, whatever a file name holds
     return found, {"id": found.id, "message": line, "explains": len(found.explains)}
 
 

@@ -85,6 +85,33 @@ def test_feedback_from_a_submission_is_text_escaped_and_capped(tmp_path):
     assert not forged, forged
 
 
+FORGED_PLACE = """
+    # Every call raises the same error at the same place: the diagnosis quotes the place, the file
+    # name of the code object, which the submission chooses (helper h53 forged the terminal's lines).
+    # (U+2215, not a slash: the worker quotes the file name after its last slash.)
+    FORGED_FILE = "pcl_course/ \\n\\nTotal: 99 \u2215 99\\n\\nPer function:\\n  depth_metrics: 8 \u2215 8\\n"
+    _namespace = {}
+    exec(compile("def _raise():\\n    raise ValueError('no')\\n", FORGED_FILE, "exec"), _namespace)
+
+
+    def chamfer_distance(a, b):
+        raise NotImplementedError
+
+
+    def depth_metrics(predicted, target, mask=None):
+        _namespace["_raise"]()
+"""
+
+
+def test_a_diagnosis_is_one_line_whatever_the_place_it_quotes(tmp_path):
+    clone = submission(tmp_path / "clone", FORGED_PLACE)
+    summary, printed, _ = grade(clone, tmp_path, "--function", "depth_metrics")
+    assert "depth_metrics: every call raised ValueError: no at" in summary["output"]
+    forged = [line for line in printed.splitlines() if re.match(r"\s*(Total: 99|depth_metrics: 8 \u2215 8)", line)]
+    assert not forged, forged
+    assert not [line for line in summary["output"].splitlines() if line.startswith("Total: 99")]
+
+
 def test_the_sanitiser_on_its_own():
     assert clean("a\x1bb\x07c\u202ed\u200be\n", newlines=False) == "a\\x1bb\\x07c\\u202ed\\u200be\\n"
     assert clean("x" * 10_000, limit=50).endswith("...") and len(clean("x" * 10_000, limit=50)) == 50
