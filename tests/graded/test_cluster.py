@@ -208,6 +208,9 @@ def test_kmeans_the_final_state_is_a_fixed_point(impl):
     start = points[[0, 1, 2, 3, 4]].copy()  # five centres from one blob
     labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start), len(points), 5, 3)
     assert n_iter < 300, f"n_iter is {n_iter}: this cloud converges well before 300 (stop when no label changes)"
+    # ... and the one these iterations reach from this start (any other fixed point would pass the rest:
+    # one centre at the mean of all, the others without points, say).
+    _check_labels(labels, lloyd(points, start)[0], " (the fixed point Lloyd's iterations reach from the start)")
     nearest, s = nearest_centres(points, centers)
     _check_labels(labels, nearest, " (each point's nearest returned centre)")
     for c in np.unique(labels):
@@ -1072,7 +1075,17 @@ def test_gmm_em_an_empty_component_and_a_falling_bound(impl):
 @pytest.mark.points(1)
 def test_gmm_em_never_lowers_the_likelihood(impl):
     points = _anisotropic(41, 600, columns=3)
-    lower_bounds = _unpack_em(impl.gmm_em(points, *_mixture_start(points, 4, 41), 60, 0.0, 0.0), 600, 4, 3)[4]
+    start = _mixture_start(points, 4, 41)
+    result = _unpack_em(impl.gmm_em(points, *start, 60, 0.0, 0.0), 600, 4, 3)
+    lower_bounds, n_iter = result[4], result[5]
+    # The bounds of this run, not any non-decreasing numbers: tol = 0 never stops it early, and the
+    # first bound is the mean log-likelihood of the start.
+    if n_iter != 60:
+        raise CheckFailed(f"n_iter = {n_iter}: with tol = 0, EM runs all max_iter = 60 iterations", rule="n_iter")
+    first = scikit_learn_em(points, *start, 1, 0.0, 0.0)[4][0]
+    check_close(lower_bounds[0], first, "lower_bounds[0]", rtol=1e-9, hint="the mean log-likelihood of the start")
+    if not np.all(np.isfinite(lower_bounds)):
+        raise CheckFailed("lower_bounds must be finite: the mean log-likelihood of each iteration's parameters")
     drops = np.diff(lower_bounds) < -1e-10 * np.abs(lower_bounds[1:])
     if np.any(drops):
         t = int(np.argmax(drops)) + 1
