@@ -98,8 +98,8 @@ class Isolation:
             return f"isolated: bubblewrap sandbox (no network, no files of the grader's), as {who}"
         if self.level == UID:
             return (
-                f"isolated: dedicated uid {self.uid} that cannot read the grader's files, network closed by "
-                f"a seccomp filter; no namespaces ({self.reason})"
+                f"isolated: dedicated uid {self.uid} that cannot read the grader's files, network and new "
+                f"processes closed by a seccomp filter; no namespaces ({self.reason})"
             )
         return f"NOT ISOLATED ({self.reason}): this is a local check, not a mark"
 

@@ -19,7 +19,8 @@ that a later call draws on from it.
 
 Outside bubblewrap, before it imports anything of the submission's, the
 worker closes the network with a seccomp filter (:func:`close_network`):
-every ``socket()`` and ``io_uring_setup()`` fails with ``EACCES``. As a
+every ``socket()`` and ``io_uring_setup()`` fails with ``EACCES``, and so
+does every new process (threads stay). As a
 dedicated uid without namespaces (a Docker container) the filter is the
 wall, and the worker refuses to run without it; under bubblewrap the empty
 network namespace is.
@@ -55,13 +56,22 @@ class _ForbiddenImports:
         return None
 
 
+CLONE_THREAD = 0x00010000  # <linux/sched.h>: a clone that makes a thread, not a process
+
+
 def close_network():
     """Install a seccomp filter that fails every ``socket()`` (any address
     family; ``socketpair()`` stays) and ``io_uring_setup()`` (io_uring can
     open sockets) with ``EACCES``, for this process and all it starts; and
     ``shmget``, ``msgget`` and ``semget`` (SysV IPC objects outlive their
     processes; POSIX shared memory is a file in ``/dev/shm``, counted and
-    removed like the others).
+    removed like the others); and every new process: ``execve``,
+    ``execveat``, ``fork``, ``vfork`` and a ``clone`` without
+    ``CLONE_THREAD`` (threads stay), ``clone3`` with ``ENOSYS`` (glibc then
+    falls back to ``clone``). A process of the submission's own would run
+    outside this worker's checks (its imports, the native code it maps),
+    with another Python of the machine's, say, and exit before the call
+    ends.
 
     Syscalls of another ABI (32-bit ``int 0x80``) kill the process
     (libseccomp's default for a foreign architecture).
@@ -77,8 +87,10 @@ def close_network():
         deny = seccomp.SyscallFilter(seccomp.ALLOW)
         # SysV IPC objects outlive every process that made them (and, as a uid's, reach the next
         # submission): refused too. Bubblewrap's IPC namespace dies with the sandbox instead.
-        for call in ("socket", "io_uring_setup", "shmget", "msgget", "semget"):
+        for call in ("socket", "io_uring_setup", "shmget", "msgget", "semget", "execve", "execveat", "fork", "vfork"):
             deny.add_rule(seccomp.ERRNO(errno.EACCES), call)
+        deny.add_rule(seccomp.ERRNO(errno.EACCES), "clone", seccomp.Arg(0, seccomp.MASKED_EQ, CLONE_THREAD, 0))
+        deny.add_rule(seccomp.ERRNO(errno.ENOSYS), "clone3")  # its flags are in memory: no rule can read them
         deny.load()  # sets no_new_privs first
     except Exception as exc:  # no libseccomp, or a kernel or container that refuses filters
         return f"no seccomp filter ({type(exc).__name__}: {exc})"
@@ -86,8 +98,11 @@ def close_network():
 
 
 def _check_network(site_packages):
-    """Measure, do not infer: after :func:`close_network`, a socket must be refused."""
+    """Measure, do not infer: after :func:`close_network`, a socket and a new process must be
+    refused, and a thread must still start."""
     import socket
+    import subprocess
+    import threading
 
     sys.path.append(site_packages)
     why_not = close_network()
@@ -97,6 +112,26 @@ def _check_network(site_packages):
             why_not = "a socket could still be opened under the seccomp filter"
         except PermissionError:
             pass
+    if why_not is None:
+        try:
+            subprocess.run([sys.executable, "-c", "pass"], check=False)
+            why_not = "a program could still be started under the seccomp filter"
+        except PermissionError:
+            pass
+    if why_not is None:
+        try:
+            if os.fork() == 0:
+                os._exit(0)
+            why_not = "a process could still be forked under the seccomp filter"
+        except PermissionError:
+            pass
+    if why_not is None:
+        thread = threading.Thread(target=lambda: None)
+        try:
+            thread.start()
+            thread.join()
+        except RuntimeError as exc:
+            why_not = f"a thread could not start under the seccomp filter ({exc})"
     print(json.dumps({"closed": why_not is None, "why": why_not}))
 
 

@@ -219,6 +219,44 @@ def test_a_generator_comes_back_only_on_its_own_stream(tmp_path, level):
         worker.close()
 
 
+PROCESSES = """
+import os, subprocess, sys, threading
+
+
+def run_program():  # another Python of the machine's could import what this worker refuses
+    return subprocess.run([sys.executable, "-c", "pass"]).returncode
+
+
+def fork():  # a child outlives the worker's checks of its imports and of the native code it maps
+    pid = os.fork()
+    if pid == 0:
+        os._exit(0)
+    return pid
+
+
+def thread():
+    seen = []
+    worker = threading.Thread(target=lambda: seen.append(1))
+    worker.start()
+    worker.join()
+    return len(seen)
+"""
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the uid mode needs root")
+def test_as_a_dedicated_uid_a_submission_starts_no_process_but_may_use_threads(tmp_path):
+    """Without namespaces the seccomp filter refuses new processes (helper h53 ran scikit-learn from
+    another environment's Python in a child that exited before the call returned)."""
+    worker = hostile_worker(tmp_path, PROCESSES, level="uid")
+    try:
+        for name in ("run_program", "fork"):
+            with pytest.raises(PermissionError):
+                worker.call("evil", name, (), {})
+        assert worker.call("evil", "thread", (), {}) == 1
+    finally:
+        worker.close()
+
+
 # -- a bounded protocol ------------------------------------------------------------------------------
 
 # Each function writes one hostile answer straight to the protocol's pipe (the worker's
