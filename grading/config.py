@@ -48,6 +48,9 @@ ASSIGNMENTS = {
         "gmm_em": "cluster",
         "dbscan": "cluster",
         "euclidean_clusters": "cluster",
+        "knn_graph": "cluster",
+        "spectral_embedding": "cluster",
+        "spectral_clustering": "cluster",
     },
 }
 GRADED_FUNCTIONS = {function: module for graded in ASSIGNMENTS.values() for function, module in graded.items()}

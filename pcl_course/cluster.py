@@ -1,5 +1,5 @@
 """Exercises of lecture 3: clustering (k-means and its seeding, Gaussian mixtures by EM, DBSCAN,
-Euclidean clusters).
+Euclidean clusters, spectral clustering).
 
 The rules of this module (the course's contract, on top of the general rules):
 
@@ -47,7 +47,16 @@ import numpy as np  # noqa: F401
 
 from pcl_course.validation import as_array, as_points, check_integer, check_rng  # noqa: F401
 
-__all__ = ["kmeans", "kmeans_plusplus", "gmm_em", "dbscan", "euclidean_clusters"]
+__all__ = [
+    "kmeans",
+    "kmeans_plusplus",
+    "gmm_em",
+    "dbscan",
+    "euclidean_clusters",
+    "knn_graph",
+    "spectral_embedding",
+    "spectral_clustering",
+]
 
 
 def kmeans(points, init_centers, max_iter=300):
@@ -328,3 +337,174 @@ def euclidean_clusters(points, tolerance, min_size=1, max_size=None):
         neither None nor an integer >= ``min_size``.
     """
     raise NotImplementedError("euclidean_clusters: not implemented yet")
+
+
+def knn_graph(points, k, sigma=None, mutual=False):
+    """The symmetric k-nearest-neighbour similarity graph, in CSR form.
+
+    1. The **neighbours** of point i are the k points j != i smallest by
+       ``(s(i, j), j)``: the nearest first, ties to the lowest index. An
+       exact duplicate of i is a neighbour at distance 0 (only i itself is
+       left out).
+    2. Points i and j are **linked** when j is a neighbour of i *or* i a
+       neighbour of j (``mutual=False``), or when each is a neighbour of the
+       other (``mutual=True``). No point is linked to itself.
+    3. A link's **weight** is ``exp(-s(i, j) / (2 * sigma ** 2))`` (a
+       Gaussian similarity: 1 for a duplicate, towards 0 far away; it may
+       underflow to 0.0, and the link is kept), or 1.0 with
+       ``sigma=None``.
+
+    The graph is returned as SciPy's CSR arrays: the links of point i are
+    ``indices[indptr[i]:indptr[i + 1]]``, in increasing order, with their
+    weights at the same places. Every link appears in both rows with the
+    same weight (``scipy.sparse.csr_array((weights, indices, indptr))`` is
+    a symmetric matrix).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+        The points, N >= 2, D >= 1.
+    k : int
+        Number of neighbours of each point, ``1 <= k <= N - 1``.
+    sigma : float or None, default None
+        The Gaussian's width, in the points' units; positive and finite.
+        None: every link weighs 1.0.
+    mutual : bool, default False
+        Link only mutual neighbours (a point may then have no link at
+        all: :func:`spectral_embedding` refuses such a graph).
+
+    Returns
+    -------
+    indptr : ndarray of int64, shape (N + 1,)
+        Row pointers: ``indptr[0] == 0``, ``indptr[N]`` the number of
+        stored entries (twice the number of links).
+    indices : ndarray of int64, shape (indptr[N],)
+        Each row's linked points, increasing within the row.
+    weights : ndarray of float64, shape (indptr[N],)
+        The links' weights, in (0, 1] (or 0.0 where the Gaussian
+        underflows).
+
+    Raises
+    ------
+    ValueError
+        Bad ``points`` (shape, non-finite, N < 2); ``k`` not an integer in
+        ``1 .. N - 1``; ``sigma`` neither None nor a positive finite
+        number; ``mutual`` not a bool.
+    """
+    raise NotImplementedError("knn_graph: not implemented yet")
+
+
+def spectral_embedding(indptr, indices, weights, n_components, normalized=True):
+    """The smallest eigenpairs of a graph's Laplacian.
+
+    With W the symmetric weight matrix of the graph (CSR, as
+    :func:`knn_graph` returns it), D the diagonal of its degrees
+    ``d_i = sum_j w_ij`` and I the identity:
+
+    * ``normalized=False``: the Laplacian ``L = D - W``;
+    * ``normalized=True``: the normalised Laplacian
+      ``L_sym = I - D^(-1/2) W D^(-1/2)``.
+
+    Return its ``n_components`` smallest eigenvalues, in increasing order,
+    and orthonormal real eigenvectors for them. An eigenvector's sign, and
+    the basis of an eigenspace of several dimensions, are free: the tests
+    compare the projector ``V V^T`` onto the span of the vectors (on
+    graphs whose eigenvalue ``n_components + 1`` is well above eigenvalue
+    ``n_components``, where that span is unique), to 1e-8, and the
+    eigenvalues to 1e-10 (absolute: they lie in [0, 2] for L_sym).
+
+    Parameters
+    ----------
+    indptr : array_like of int, shape (N + 1,)
+        Row pointers, N >= 1: ``indptr[0] == 0``, non-decreasing, and
+        ``indptr[N] == len(indices)``.
+    indices : array_like of int, shape (indptr[N],)
+        Each row's columns, in ``0 .. N - 1``, strictly increasing within a
+        row (no entry twice), and never the row itself (no self-loop).
+    weights : array_like of float, shape (indptr[N],)
+        The entries of W: finite, >= 0, symmetric (``w_ij == w_ji``, an
+        entry of row i in column j stored in row j at column i too), every
+        vertex of positive degree.
+    n_components : int
+        Number of eigenpairs, ``1 <= n_components <= N``.
+    normalized : bool, default True
+        Use L_sym (True) or L (False).
+
+    Returns
+    -------
+    eigenvalues : ndarray of float64, shape (n_components,)
+        The smallest eigenvalues, increasing (the first is 0 up to
+        rounding: the constant vector, or ``D^(1/2)`` times it, is in the
+        kernel).
+    vectors : ndarray of float64, shape (N, n_components)
+        Orthonormal eigenvectors, column m for eigenvalue m.
+
+    Raises
+    ------
+    ValueError
+        Bad ``indptr`` (shape, not integers, not a valid set of row
+        pointers); bad ``indices`` (length, not integers, out of range,
+        unsorted or repeated within a row, a self-loop); bad ``weights``
+        (length, non-finite, negative, not symmetric, a vertex of degree
+        0); ``n_components`` not an integer in ``1 .. N``; ``normalized``
+        not a bool.
+    """
+    raise NotImplementedError("spectral_embedding: not implemented yet")
+
+
+def spectral_clustering(points, n_clusters, k=10, sigma=None):
+    """Spectral clustering by Ng, Jordan and Weiss, made canonical.
+
+    1. ``graph = knn_graph(points, k, sigma)`` (``mutual=False``).
+    2. ``_, U = spectral_embedding(*graph, n_clusters, normalized=True)``.
+    3. **Rows to the unit sphere:** Y is U with each row divided by its
+       length.
+    4. **Initial centres, farthest first:** row 0 of Y; then, n_clusters - 1
+       times, the row whose squared distance to its nearest chosen row is
+       the largest (ties to the lowest index).
+    5. ``labels = kmeans(Y, those rows)`` (the contract's k-means, with
+       its ``max_iter=300``).
+    6. **Renumber by first appearance:** point 0's cluster becomes 0, the
+       cluster of the first point not in it 1, and so on.
+
+    Before step 2, two checks: a point whose links all weigh 0.0 (the
+    Gaussian underflows: ``sigma`` too small for its nearest neighbours)
+    is a ``ValueError`` naming ``sigma``; a graph whose links of positive
+    weight make more than ``n_clusters`` connected components is a
+    ``ValueError`` naming ``n_clusters`` (eigenvalue 0 then has more than
+    ``n_clusters`` independent eigenvectors: U, and the labels, would
+    depend on the eigensolver, and rows of U could be 0).
+
+    Steps 3 to 6 depend on Y only through the distances between its rows,
+    which a rotation of the eigenvectors' basis (``U R``, R orthogonal:
+    another eigensolver's answer, or other signs) does not change: the
+    labels are the same for any orthonormal basis of the eigenspace (the
+    book proves it). They are canonical when that eigenspace is unique:
+    when eigenvalue ``n_clusters + 1`` of L_sym is above eigenvalue
+    ``n_clusters`` (the tests' clouds have a clear gap).
+
+    Parameters
+    ----------
+    points : array_like, shape (N, D)
+        The points, N >= 2, D >= 1.
+    n_clusters : int
+        Number of clusters, ``1 <= n_clusters <= N``.
+    k : int, default 10
+        Neighbours of the kNN graph, ``1 <= k <= N - 1``.
+    sigma : float or None, default None
+        The graph's Gaussian width (None: weights 1).
+
+    Returns
+    -------
+    labels : ndarray of int64, shape (N,)
+        Each point's cluster, numbered by first appearance.
+
+    Raises
+    ------
+    ValueError
+        As :func:`knn_graph` for ``points``, ``k`` and ``sigma``;
+        ``n_clusters`` not an integer in ``1 .. N``; a point whose links
+        all weigh 0.0 (``sigma``); more connected components than
+        ``n_clusters`` (``n_clusters``).
+    """
+    raise NotImplementedError("spectral_clustering: not implemented yet")

@@ -51,6 +51,8 @@ __all__ = [
     "clusters_top_view",
     "mixture_iterations",
     "clustering_grid",
+    "small_graph",
+    "spectral_panels",
 ]
 
 
@@ -1521,5 +1523,107 @@ def clustering_grid(clouds, results, figsize=(14, 14.5)):
         ax.set_ylabel(row, fontsize=10)
     for ax, column in zip(axes[0], columns):
         ax.set_title(column, fontsize=10)
+    fig.tight_layout()
+    plt.show()
+
+
+def _graph_segments(points, indptr, indices):
+    """Each link {i, j} of a CSR graph once (i < j), as a (M, 2, 2) array of segments."""
+    indptr, indices = np.asarray(indptr), np.asarray(indices)
+    rows = np.repeat(np.arange(len(indptr) - 1), np.diff(indptr))
+    once = rows < indices
+    return np.stack([points[rows[once], :2], points[indices[once], :2]], axis=1)
+
+
+def small_graph(points, indptr, indices, weights, vectors, names, figsize=(11, 3.6)):
+    """A small weighted graph, its links as wide as their weights, and some eigenvectors as bars.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+        Where the vertices are drawn.
+    indptr, indices, weights : array_like
+        The graph in CSR form (both directions of every link stored).
+    vectors : array_like of shape (N, M)
+        Eigenvectors, one per column; the vertices are coloured by the sign of the last one.
+    names : sequence of str
+        A legend entry for each column of ``vectors``.
+    figsize : tuple of float, default (11, 3.6)
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+
+    points, weights, vectors = (np.asarray(a, dtype=float) for a in (points, weights, vectors))
+    indptr, indices = np.asarray(indptr), np.asarray(indices)
+    rows = np.repeat(np.arange(len(points)), np.diff(indptr))
+    once = rows < indices
+    fig, (left, right) = plt.subplots(1, 2, figsize=figsize, gridspec_kw={"width_ratios": [1, 1.3]})
+    left.add_collection(LineCollection(_graph_segments(points, indptr, indices), colors="0.5",
+                                       linewidths=0.5 + 3.0 * weights[once] / weights.max()))  # fmt: skip
+    for i, j, w in zip(rows[once], indices[once], weights[once]):
+        left.annotate(f"{w:g}", (points[i] + points[j]) / 2, xytext=(0, 5), textcoords="offset points",
+                      ha="center", fontsize=8, color="0.3")  # fmt: skip
+    sign = vectors[:, -1] >= 0
+    left.scatter(*points.T, s=260, c=np.where(sign, "C0", "C1"), ec="k", zorder=3)
+    for i, p in enumerate(points):
+        left.annotate(str(i), p, ha="center", va="center", color="w", fontsize=9, zorder=4)
+    left.set(aspect="equal", xticks=[], yticks=[], title="the graph (colour: the sign of the last vector)")
+    left.margins(0.15)
+    width = 0.8 / vectors.shape[1]
+    for m, name in enumerate(names):
+        right.bar(np.arange(len(points)) + (m - (vectors.shape[1] - 1) / 2) * width, vectors[:, m], width,
+                  label=name, color=f"C{m + 2}")  # fmt: skip
+    right.axhline(0, c="k", lw=0.8)
+    low, high = min(vectors.min(), 0.0), max(vectors.max(), 0.0)
+    right.set(
+        xticks=np.arange(len(points)),
+        xlabel="vertex",
+        ylabel="entry",
+        title="eigenvectors of L",
+        ylim=(low - 0.1 * (high - low), high + 0.45 * (high - low)),
+    )  # room for the legend above the bars
+    right.legend(fontsize=8, loc="upper center", ncol=2)
+    fig.tight_layout()
+    plt.show()
+
+
+def spectral_panels(points, indptr, indices, eigenvalues, rows, labels, figsize=(11, 8.2)):
+    """Spectral clustering of a 2-D cloud in four panels: graph, spectrum, embedding, labels.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+    indptr, indices : array_like
+        The similarity graph in CSR form.
+    eigenvalues : array_like of shape (M,)
+        The smallest eigenvalues of the graph's Laplacian, increasing.
+    rows : array_like of shape (N, 2)
+        The rows of the embedding on the unit circle (Y), drawn with a small jitter along the circle
+        so that coincident rows stay visible.
+    labels : array_like of shape (N,)
+        The clusters.
+    figsize : tuple of float, default (11, 8.2)
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+
+    points, rows, eigenvalues = (np.asarray(a, dtype=float) for a in (points, rows, eigenvalues))
+    colours = [f"C{k % 10}" for k in np.asarray(labels)]
+    fig, axes = plt.subplots(2, 2, figsize=figsize)
+    graph, spectrum, embedding, clusters = axes.flat
+    graph.add_collection(LineCollection(_graph_segments(points, indptr, indices), colors="0.4", linewidths=0.4))
+    graph.scatter(*points.T, s=3, c="k", lw=0)
+    graph.set(aspect="equal", xticks=[], yticks=[], title=f"the kNN graph: {len(indices) // 2:,} links")
+    spectrum.plot(np.arange(1, len(eigenvalues) + 1), eigenvalues, "o-", c="k", ms=4)
+    spectrum.set(xlabel="m", ylabel="eigenvalue m of $L_{sym}$", title="the smallest eigenvalues")
+    spectrum.set_xticks(np.arange(1, len(eigenvalues) + 1))
+    spectrum.grid(alpha=0.3)
+    angle = np.arctan2(rows[:, 1], rows[:, 0]) + np.random.default_rng(0).normal(0, 0.04, len(rows))
+    embedding.plot(np.cos(np.linspace(0, 2 * np.pi, 200)), np.sin(np.linspace(0, 2 * np.pi, 200)), c="0.8")
+    embedding.scatter(np.cos(angle), np.sin(angle), s=6, c=colours, lw=0)
+    embedding.set(aspect="equal", xlim=(-1.3, 1.3), ylim=(-1.3, 1.3), xlabel="$y_{i0}$", ylabel="$y_{i1}$",
+                  title="the rows of Y (jittered along the circle)")  # fmt: skip
+    clusters.scatter(*points.T, s=4, c=colours, lw=0)
+    clusters.set(aspect="equal", xticks=[], yticks=[], title="the labels")
     fig.tight_layout()
     plt.show()

@@ -20,6 +20,8 @@ __all__ = [
     "check_choice",
     "check_rng",
     "check_radius",
+    "check_bool",
+    "check_graph",
     "check_bst",
     "check_kdtree",
     "check_octree",
@@ -235,6 +237,69 @@ def check_rng(rng, name="rng"):
     if isinstance(rng, numbers.Integral) and not isinstance(rng, bool) and rng >= 0:
         return np.random.default_rng(int(rng))
     raise ValueError(f"{name} must be None, a non-negative int seed or a numpy Generator, got {rng!r}")
+
+
+def check_bool(value, name):
+    """Return ``value`` as a bool after checking it is one (``True``, ``False`` or a NumPy bool)."""
+    if not isinstance(value, bool | np.bool_):
+        raise ValueError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _as_index_array(values, name):
+    """A 1-D array of integers as int64 (booleans and floats refused, even integral ones)."""
+    array = np.asarray(values)
+    if array.ndim != 1 or (array.size and array.dtype.kind not in "iu"):
+        raise ValueError(f"{name} must be a 1-D array of integers, got {array.dtype} of shape {array.shape}")
+    return array.astype(np.int64)
+
+
+def check_graph(indptr, indices, weights):
+    """Check a weighted undirected graph in CSR form and return it as arrays.
+
+    The graph of :func:`pcl_course.cluster.knn_graph`: ``indptr`` (N + 1,)
+    row pointers, N >= 1; ``indices`` each row's columns, strictly
+    increasing within the row, never the row itself; ``weights`` finite,
+    >= 0 and symmetric (``w_ij == w_ji``, both stored), every vertex of
+    positive degree.
+
+    Returns
+    -------
+    indptr : ndarray of int64, shape (N + 1,)
+    indices : ndarray of int64, shape (indptr[N],)
+    weights : ndarray of float64, shape (indptr[N],)
+    degrees : ndarray of float64, shape (N,)
+        ``d_i = sum_j w_ij``, summed in each row's order.
+    """
+    indptr = _as_index_array(indptr, "indptr")
+    if len(indptr) < 2 or indptr[0] != 0 or np.any(np.diff(indptr) < 0):
+        raise ValueError("indptr must hold N + 1 >= 2 row pointers, starting at 0 and non-decreasing")
+    n = len(indptr) - 1
+    indices = _as_index_array(indices, "indices")
+    if len(indices) != indptr[-1]:
+        raise ValueError(f"indices must hold indptr[N] = {indptr[-1]} entries, got {len(indices)}")
+    rows = np.repeat(np.arange(n), np.diff(indptr))
+    if np.any(indices < 0) or np.any(indices >= n):
+        raise ValueError(f"indices must lie in 0 .. {n - 1} (N - 1)")
+    if np.any(indices == rows):
+        raise ValueError(f"indices: row {int(rows[np.argmax(indices == rows)])} links the vertex to itself")
+    if np.any((np.diff(indices) <= 0) & (rows[1:] == rows[:-1])):
+        raise ValueError("indices must be strictly increasing within each row")
+    weights = as_array(weights, "weights", ndim=1)
+    if len(weights) != len(indices):
+        raise ValueError(f"weights must hold one weight per entry ({len(indices)}), got {len(weights)}")
+    if np.any(weights < 0):
+        raise ValueError("weights must be >= 0")
+    # Symmetric: the entries sorted by (row, column) and by (column, row) are the same list.
+    by_column = np.lexsort((rows, indices))
+    if not (np.array_equal(indices[by_column], rows) and np.array_equal(rows[by_column], indices)) or not (
+        np.array_equal(weights[by_column], weights)
+    ):
+        raise ValueError("weights must be symmetric: w_ij stored in row i, column j and in row j, column i, equal")
+    degrees = np.bincount(rows, weights=weights, minlength=n)
+    if np.any(degrees <= 0):
+        raise ValueError(f"weights: vertex {int(np.argmax(degrees <= 0))} has degree 0 (no link of positive weight)")
+    return indptr, indices, weights, degrees
 
 
 def check_radius(value, name="radius"):

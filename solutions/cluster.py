@@ -1,17 +1,38 @@
-"""Reference: k-means (Lloyd's algorithm), the k-means++ seeding, Gaussian mixtures by EM, DBSCAN and
-Euclidean cluster extraction. The docstrings are the stubs' (``pcl_course/cluster.py``: the contract)."""
+"""Reference: k-means (Lloyd's algorithm), the k-means++ seeding, Gaussian mixtures by EM, DBSCAN,
+Euclidean cluster extraction and spectral clustering (Ng, Jordan and Weiss). The docstrings are the
+stubs' (``pcl_course/cluster.py``: the contract)."""
 
 import numpy as np
 from scipy import linalg
+from scipy.sparse import csr_array
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 from scipy.special import logsumexp
 
 from pcl_course import cluster as _contract
-from pcl_course.validation import as_array, as_points, check_integer, check_positive, check_rng, check_scalar
+from pcl_course.validation import (
+    as_array,
+    as_points,
+    check_bool,
+    check_graph,
+    check_integer,
+    check_positive,
+    check_rng,
+    check_scalar,
+)
 from solutions._fast.density import density_clusters
 from solutions._fast.lloyd import assign, cluster_sums
 
-__all__ = ["kmeans", "kmeans_plusplus", "gmm_em", "dbscan", "euclidean_clusters"]
+__all__ = [
+    "kmeans",
+    "kmeans_plusplus",
+    "gmm_em",
+    "dbscan",
+    "euclidean_clusters",
+    "knn_graph",
+    "spectral_embedding",
+    "spectral_clustering",
+]
 
 
 def _documented(function):
@@ -193,3 +214,118 @@ def euclidean_clusters(points, tolerance, min_size=1, max_size=None):
     renumbered = np.full(len(sizes), -1, dtype=np.int64)
     renumbered[order] = np.arange(len(order))
     return renumbered[components]
+
+
+_BLOCK = 1024  # rows of squared distances at a time: (1024, N) float64
+
+
+def _nearest_neighbours(points, k):
+    """Each point's k neighbours by ``(s, j)``, itself left out: (N, k) int64."""
+    n = len(points)
+    neighbours = np.empty((n, k), dtype=np.int64)
+    for start in range(0, n, _BLOCK):
+        stop = min(n, start + _BLOCK)
+        s = _squared_distances(points[start:stop], points)
+        s[np.arange(stop - start), np.arange(start, stop)] = np.inf  # the point itself, not its duplicates
+        kth = np.partition(s, k - 1, axis=1)[:, k - 1]
+        rows, columns = np.nonzero(s <= kth[:, None])  # the k nearest and every tie of the k-th
+        order = np.lexsort((columns, s[rows, columns], rows))  # by row, then (s, j)
+        rows, columns = rows[order], columns[order]
+        rank = np.arange(len(rows)) - np.searchsorted(rows, rows)
+        neighbours[start:stop] = columns[rank < k].reshape(stop - start, k)
+    return neighbours
+
+
+@_documented
+def knn_graph(points, k, sigma=None, mutual=False):
+    points = as_points(points, min_columns=1, allow_empty=False)
+    n = len(points)
+    if n < 2:
+        raise ValueError(f"points must hold at least 2 points (a graph needs neighbours), got {n}")
+    k = check_integer(k, "k", low=1, high=n - 1)
+    if sigma is not None:
+        sigma = check_positive(sigma, "sigma")
+    mutual = check_bool(mutual, "mutual")
+    heads = np.repeat(np.arange(n, dtype=np.int64), k)
+    tails = _nearest_neighbours(points, k).ravel()
+    # Each directed edge i -> j as the code i N + j; the undirected links as codes in both directions.
+    forward, backward = heads * n + tails, tails * n + heads
+    codes = np.intersect1d(forward, backward) if mutual else np.union1d(forward, backward)
+    rows, columns = codes // n, codes % n  # sorted by row, then column
+    indptr = np.searchsorted(rows, np.arange(n + 1)).astype(np.int64)
+    if sigma is None:
+        weights = np.ones(len(codes))
+    else:
+        s = np.zeros(len(codes))
+        for j in range(points.shape[1]):  # the contract's order: s(i, j) == s(j, i) exactly
+            s += np.square(points[rows, j] - points[columns, j])
+        weights = np.exp(-s / (2.0 * sigma * sigma))
+    return indptr, columns.astype(np.int64), weights
+
+
+@_documented
+def spectral_embedding(indptr, indices, weights, n_components, normalized=True):
+    indptr, indices, weights, degrees = check_graph(indptr, indices, weights)
+    n = len(degrees)
+    n_components = check_integer(n_components, "n_components", low=1, high=n)
+    normalized = check_bool(normalized, "normalized")
+    rows = np.repeat(np.arange(n), np.diff(indptr))
+    laplacian = np.zeros((n, n))
+    if normalized:
+        scale = 1.0 / np.sqrt(degrees)
+        laplacian[rows, indices] = -weights * scale[rows] * scale[indices]
+        laplacian[np.diag_indices(n)] = 1.0
+    else:
+        laplacian[rows, indices] = -weights
+        laplacian[np.diag_indices(n)] = degrees
+    eigenvalues, vectors = linalg.eigh(laplacian, subset_by_index=[0, n_components - 1])
+    return eigenvalues, vectors
+
+
+def _check_components(indptr, indices, weights, n_clusters, sigma):
+    """The contract's two checks of the graph before its embedding (ValueError naming sigma, n_clusters)."""
+    n = len(indptr) - 1
+    rows = np.repeat(np.arange(n), np.diff(indptr))
+    positive = weights > 0
+    degrees = np.bincount(rows, weights=weights, minlength=n)
+    if np.any(degrees <= 0):
+        raise ValueError(
+            f"sigma = {sigma} is too small: every link of point {int(np.argmax(degrees <= 0))} weighs "
+            "exp(-s / (2 sigma^2)) = 0.0"
+        )
+    count, _ = connected_components(csr_array((weights[positive], (rows[positive], indices[positive])), shape=(n, n)))
+    if count > n_clusters:
+        raise ValueError(
+            f"n_clusters = {n_clusters} is below the {count} connected components of the kNN graph: its "
+            "embedding is not unique (raise n_clusters or k)"
+        )
+
+
+def _farthest_first(rows, count):
+    """``count`` rows picked farthest first from row 0 (by s, ties to the lowest index)."""
+    picked = [0]
+    nearest = _squared_distances(rows, rows[:1])[:, 0]
+    for _ in range(count - 1):
+        picked.append(int(np.argmax(nearest)))
+        nearest = np.minimum(nearest, _squared_distances(rows, rows[picked[-1:]])[:, 0])
+    return np.array(picked)
+
+
+def _by_first_appearance(labels):
+    """Labels renumbered 0, 1, ... in the order their clusters first appear."""
+    _, first = np.unique(labels, return_index=True)
+    renumbered = np.empty(labels.max() + 1, dtype=np.int64)
+    renumbered[labels[np.sort(first)]] = np.arange(len(first))
+    return renumbered[labels]
+
+
+@_documented
+def spectral_clustering(points, n_clusters, k=10, sigma=None):
+    points = as_points(points, min_columns=1, allow_empty=False)
+    n_clusters = check_integer(n_clusters, "n_clusters", low=1, high=max(len(points), 1))
+    graph = knn_graph(points, k, sigma)
+    _check_components(*graph, n_clusters, sigma)
+    _, vectors = spectral_embedding(*graph, n_clusters, normalized=True)
+    rows = vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
+    labels, _, _, _ = kmeans(rows, rows[_farthest_first(rows, n_clusters)])
+    return _by_first_appearance(labels)

@@ -10,7 +10,16 @@ import warnings
 
 import numpy as np
 
-__all__ = ["nearest_centres", "lloyd", "linked_components", "scikit_learn_em"]
+__all__ = [
+    "nearest_centres",
+    "lloyd",
+    "linked_components",
+    "scikit_learn_em",
+    "neighbour_graph",
+    "laplacian",
+    "projector_distance",
+    "njw_labels",
+]
 
 
 def nearest_centres(points, centers):
@@ -76,3 +85,65 @@ def scikit_learn_em(points, weights, means, covariances, max_iter=100, tol=1e-3,
         fitted.fit(points)
     parameters = (fitted.weights_, fitted.means_, fitted.covariances_)
     return (*parameters, fitted.predict_proba(points), np.array(fitted.lower_bounds_), fitted.n_iter_)
+
+
+def _squared_matrix(points):
+    """(N, N) squared distances, summed over the columns in increasing order."""
+    return sum((points[:, j, None] - points[None, :, j]) ** 2 for j in range(points.shape[1]))
+
+
+def neighbour_graph(points, k, sigma=None, mutual=False):
+    """The contract's kNN graph by brute force: ``(indptr, indices, weights)``, rows sorted (SciPy's
+    CSR of the dense link matrix)."""
+    from scipy.sparse import csr_array
+
+    points = np.asarray(points, dtype=float)
+    n = len(points)
+    s = _squared_matrix(points)
+    directed = np.zeros((n, n), dtype=bool)
+    for i in range(n):
+        others = np.delete(np.arange(n), i)
+        nearest = others[np.lexsort((others, s[i, others]))[:k]]  # by (s, j)
+        directed[i, nearest] = True
+    links = directed & directed.T if mutual else directed | directed.T
+    graph = csr_array(links)
+    graph.sort_indices()
+    rows = np.repeat(np.arange(n), np.diff(graph.indptr))
+    weights = np.ones(len(graph.indices)) if sigma is None else np.exp(-s[rows, graph.indices] / (2 * sigma**2))
+    return graph.indptr.astype(np.int64), graph.indices.astype(np.int64), weights
+
+
+def laplacian(indptr, indices, weights, normalized=True):
+    """The dense L = D - W, or L_sym = I - D^-1/2 W D^-1/2, of a CSR graph."""
+    from scipy.sparse import csr_array
+
+    n = len(indptr) - 1
+    w = csr_array((weights, indices, indptr), shape=(n, n)).toarray()
+    d = w.sum(axis=1)
+    if not normalized:
+        return np.diag(d) - w
+    return np.eye(n) - w / np.sqrt(np.outer(d, d))
+
+
+def projector_distance(a, b):
+    """The largest entry of |A A^T - B B^T|: how far apart the spans of two orthonormal bases are."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return float(np.abs(a @ a.T - b @ b.T).max())
+
+
+def njw_labels(points, n_clusters, k=10, sigma=None):
+    """The contract's canonical NJW labels, from SciPy's eigh of the dense L_sym."""
+    from scipy.linalg import eigh
+
+    u = eigh(laplacian(*neighbour_graph(points, k, sigma), normalized=True), subset_by_index=[0, n_clusters - 1])[1]
+    y = u / np.linalg.norm(u, axis=1, keepdims=True)
+    picked = [0]
+    nearest = ((y - y[0]) ** 2).sum(axis=1)
+    for _ in range(n_clusters - 1):
+        picked.append(int(np.argmax(nearest)))
+        nearest = np.minimum(nearest, nearest_centres(y, y[picked[-1:]])[1][:, 0])
+    labels = lloyd(y, y[picked])[0]
+    _, first = np.unique(labels, return_index=True)
+    renumbered = np.full(n_clusters, -1, dtype=np.int64)
+    renumbered[labels[np.sort(first)]] = np.arange(len(first))  # the r-th cluster to appear becomes r
+    return renumbered[labels]

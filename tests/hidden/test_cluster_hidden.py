@@ -6,7 +6,15 @@ import numpy as np
 import pytest
 
 from grading.checks import CheckFailed, check_array, check_close
-from grading.checks.cluster import linked_components, lloyd, scikit_learn_em
+from grading.checks.cluster import (
+    laplacian,
+    linked_components,
+    lloyd,
+    neighbour_graph,
+    njw_labels,
+    projector_distance,
+    scikit_learn_em,
+)
 
 # Run by the instructors' grader only; feedback withholds expected values.
 pytestmark = pytest.mark.hidden
@@ -207,3 +215,65 @@ def test_gmm_em_hidden_new_mixtures_and_utm_like_coordinates(impl):
         offset = np.array([525_000.0, 4_200_000.0, 35.0, 10.0])[:columns]
         shifted = (start[0], start[1] + offset, start[2])
         _check_em(impl, points + offset, shifted, 150, 1e-6, 1e-6, "far from the origin", rtol=1e-7)
+
+
+@pytest.mark.grades("knn_graph")
+@pytest.mark.points(2)
+def test_knn_graph_hidden_street_like_clouds_with_duplicates(impl):
+    for seed, k, sigma, mutual in ((11, 6, None, False), (12, 9, 0.7, False), (13, 4, 1.5, True)):
+        points = _street_like(seed)[::3]
+        points = np.vstack([points, points[:30]])  # duplicates: neighbours at distance 0
+        expected = neighbour_graph(points, k, sigma, mutual)
+        result = impl.knn_graph(points, k, sigma, mutual)
+        if not isinstance(result, tuple) or len(result) != 3:
+            raise CheckFailed("knn_graph must return a tuple of three")
+        indptr, indices, weights = result
+        check_array(indptr, "indptr", shape=(len(points) + 1,), dtype="int64")
+        if not (np.array_equal(indptr, expected[0]) and np.array_equal(indices, expected[1])):
+            raise CheckFailed(
+                f"the links are wrong on a new cloud (k = {k}, mutual = {mutual})", rule="the links are wrong"
+            )
+        check_close(weights, expected[2], "weights", rtol=1e-12, atol=0, hint="on a new cloud")
+
+
+@pytest.mark.grades("spectral_embedding")
+@pytest.mark.points(2)
+def test_spectral_embedding_hidden_weighted_random_graphs(impl):
+    from scipy.linalg import eigh
+    from scipy.sparse import csr_array, random_array
+
+    rng = np.random.default_rng(14)
+    for n, density, m in ((120, 0.05, 3), (200, 0.02, 5)):
+        upper = random_array((n, n), density=density, rng=rng, data_sampler=lambda size: rng.uniform(0.1, 2.0, size))
+        dense = np.triu(upper.toarray(), 1)
+        dense = dense + dense.T
+        dense[np.arange(n - 1), np.arange(1, n)] = dense[np.arange(1, n), np.arange(n - 1)] = 0.5  # connected
+        graph = csr_array(dense)
+        graph.sort_indices()
+        arrays = (graph.indptr.astype(np.int64), graph.indices.astype(np.int64), graph.data)
+        for normalized in (True, False):
+            values, vectors = eigh(laplacian(*arrays, normalized=normalized))
+            result = impl.spectral_embedding(*arrays, m, normalized)
+            if not isinstance(result, tuple) or len(result) != 2:
+                raise CheckFailed("spectral_embedding must return a tuple of two")
+            check_close(result[0], values[:m], "eigenvalues", rtol=0, atol=1e-10, hint="on a new weighted graph")
+            check_array(result[1], "vectors", shape=(n, m))
+            if projector_distance(result[1], vectors[:, :m]) > 1e-8:
+                raise CheckFailed(
+                    "the vectors span the wrong space on a new weighted graph",
+                    rule="the eigenvectors span the wrong space",
+                )
+
+
+@pytest.mark.grades("spectral_clustering")
+@pytest.mark.points(2)
+def test_spectral_clustering_hidden_new_shapes(impl):
+    from sklearn.datasets import make_blobs, make_moons
+
+    moons, _ = make_moons(300, noise=0.05, random_state=15)
+    blobs, _ = make_blobs(360, centers=6, n_features=3, cluster_std=0.6, random_state=16)
+    for points, n_clusters, k, sigma in ((moons + [3.0e5, 4.0e6], 2, 9, None), (blobs, 6, 12, 2.0)):
+        labels = impl.spectral_clustering(points, n_clusters, k, sigma)
+        check_array(labels, "labels", shape=(len(points),), dtype="int64")
+        if not np.array_equal(labels, njw_labels(points, n_clusters, k, sigma)):
+            raise CheckFailed(f"labels are wrong on a new cloud of {n_clusters} clusters", rule="labels are wrong")

@@ -1,6 +1,6 @@
 """Known mistakes of ``pcl_course/cluster.py`` (lecture 3): k-means, the k-means++ seeding, and
 through the modules beside it, Gaussian mixtures (``_mixture.py``), DBSCAN and Euclidean clusters
-(``_density.py``).
+(``_density.py``), the kNN graph, its spectral embedding and spectral clustering (``_spectral.py``).
 
 The truths follow ``pcl_course/cluster.py``'s contract step by step, in
 NumPy: squared distances summed over the columns in increasing order, ties
@@ -22,6 +22,7 @@ import numpy as np
 from grading.instructors.mistakes import RANDOM, Mistake, Model, Variants, valid_integer, valid_points
 from grading.instructors.mistakes._density import DBSCAN, EUCLIDEAN_CLUSTERS
 from grading.instructors.mistakes._mixture import GMM_EM
+from grading.instructors.mistakes._spectral import KNN_GRAPH, SPECTRAL_CLUSTERING, SPECTRAL_EMBEDDING
 
 MAX_KMEANS_WORK = 2_000_000_000  # points x centres x columns x iterations replayed
 MAX_SEEDING_WORK = 400_000_000  # points x seeds x columns replayed
@@ -340,4 +341,7 @@ MODELS = {
     "gmm_em": GMM_EM,
     "dbscan": DBSCAN,
     "euclidean_clusters": EUCLIDEAN_CLUSTERS,
+    "knn_graph": KNN_GRAPH,
+    "spectral_embedding": SPECTRAL_EMBEDDING,
+    "spectral_clustering": SPECTRAL_CLUSTERING,
 }
