@@ -57,7 +57,7 @@ lint: setup
 # after a change to the package, the build itself runs every page: nbval would only repeat
 # it). The build (then the checks of the built book, marker book) and nbval run one page or
 # one browser at a time on one core, and many project tests wait on a subprocess: all run
-# side by side with the project's tests that do not read the built book, on three workers
+# side by side with the project's tests that do not read the built book, on four workers
 # (README "Tests"). --maxschedchunk=1: xdist hands each worker its next test as it finishes one
 # (by default it deals out a quarter of a worker's share at once, so all the tests marked long,
 # collected first, went to one worker). Every limit of the tests is CPU time, or a wall-clock
@@ -78,7 +78,7 @@ numba-cache: setup $(NUMBA_STAMP)
 	    tail -n 20 _build/numba-cache.log _build/numba-cache-checked.log; \
 	    echo "make numba-cache: grading the reference failed"; exit 1; fi
 
-# The tests' processes (three workers beside the book on two cores) run their linear algebra on one
+# The tests' processes (four workers beside the book on two cores) run their linear algebra on one
 # BLAS and OpenMP thread, as the grader's do (grading.config.GRADER_ENVIRONMENT, read from there):
 # threads spinning on a machine already full cost more than they give (a subset of the project's
 # tests took 65 s of wall clock and 52 s of CPU with OpenBLAS's default threads, 38 s and 40 s with one).
@@ -97,7 +97,7 @@ test: lint $(CODE_STAMP) $(NUMBA_STAMP) numba-cache
 	      > _build/nbval.log 2>&1; echo $$? > _build/nbval.status; \
 	  else echo "nbval: not run, the book's build executed every page (no execution cache)" > _build/nbval.log; \
 	      echo 0 > _build/nbval.status; fi; } & \
-	env $(TEST_THREADS) $(BIN)/python -m pytest -n 3 --maxschedchunk=1 --durations=20 -m "not book"; tests=$$?; \
+	env $(TEST_THREADS) $(BIN)/python -m pytest -n 4 --maxschedchunk=1 --durations=20 -m "not book"; tests=$$?; \
 	wait; tail -n 1 _build/nbval.log; tail -n 1 _build/book.log; \
 	if [ "$$(cat _build/book.status)" != 0 ]; then cat _build/book.log; echo "make test: the book's build or its checks failed"; exit 1; fi; \
 	if [ "$$(cat _build/nbval.status)" != 0 ]; then cat _build/nbval.log; echo "make test: nbval failed"; exit 1; fi; \
