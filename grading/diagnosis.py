@@ -61,7 +61,7 @@ class Call:
     error_type: str = None
     error: str = None  # the exception's first line
     where: str = None  # file:line in the submission, when known
-    modified: bool = False
+    modified: tuple = ()  # the contract's names of the arguments it changed in place
     kept: bool = True  # False: the arguments were too large to keep
 
     @property

@@ -256,7 +256,7 @@ class Implementation:
                 raise
             finally:
                 self.last_modified = argument_names(name, modified)
-                call.modified = bool(self.last_modified)
+                call.modified = tuple(self.last_modified)
             self.recorder.received_answer(result)
             fits, copied = self.recorder.keep_result(result) if kept is not None else (False, None)
             if fits:
@@ -269,6 +269,16 @@ class Implementation:
 
         graded_call.__name__ = name
         return graded_call
+
+    def modified_in_test(self, function):
+        """The calls of ``function`` in the test under way that modified an argument in place.
+
+        Every call counts, not only the last: a function that changes its input
+        only on some path (given a Generator, say) is caught by whichever call
+        took that path. Returns ``(calls made, [(call number from 1, argument names)])``.
+        """
+        calls = [call for call in self.calls.get(function, []) if call.test == self.current_test]
+        return len(calls), [(i, list(call.modified)) for i, call in enumerate(calls, 1) if call.modified]
 
     @property
     def last_call(self):

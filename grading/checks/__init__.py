@@ -141,16 +141,19 @@ def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
 
 
 def check_unmodified(impl, function):
-    """Check that the last call of ``impl`` modified none of its arguments in place.
+    """Check that no call of ``function`` in this test modified its arguments in place.
 
     The grader's arguments are never changed by a call (each call works on
     private copies): whether it modified them is recorded as the call's
-    verdict, :attr:`grading.implementation.Implementation.last_modified`.
+    verdict, and every call of the test so far counts
+    (:meth:`grading.implementation.Implementation.modified_in_test`).
     """
-    if impl.last_modified:
-        names = ", ".join(impl.last_modified)
+    made, modified = impl.modified_in_test(function)
+    if modified:
+        number, names = modified[0]
+        where = f", in call {number} of {made} in this test" if made > 1 else ""
         raise CheckFailed(
-            f"{function} modified its input in place ({names}): work on a copy "
+            f"{function} modified its input in place ({', '.join(names)}{where}): work on a copy "
             "(np.array(points, dtype=float) copies; points -= ... does not)",
             rule="an input was modified in place",
         )
