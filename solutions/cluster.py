@@ -283,7 +283,10 @@ def spectral_embedding(indptr, indices, weights, n_components, normalized=True):
 
 
 def _check_components(indptr, indices, weights, n_clusters, sigma):
-    """The contract's two checks of the graph before its embedding (ValueError naming sigma, n_clusters)."""
+    """The contract's two checks of the graph before its embedding (ValueError naming sigma, n_clusters).
+
+    The degrees are summed here, not taken from ``check_graph``: a vertex of degree 0 is the
+    contract's error naming ``sigma`` (the weights underflowed), where check_graph names ``weights``."""
     n = len(indptr) - 1
     rows = np.repeat(np.arange(n), np.diff(indptr))
     positive = weights > 0

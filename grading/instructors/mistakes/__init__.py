@@ -76,6 +76,15 @@ def valid_positive(value):
     return float(value)
 
 
+def same_integers(a, b):
+    """Whether ``a`` and ``b`` are integer arrays of one shape holding the same values (labels, indices)."""
+    try:
+        a, b = np.asarray(a), np.asarray(b)
+    except Exception:  # an answer of any type: not integers
+        return False
+    return a.shape == b.shape and a.dtype.kind in "iu" and b.dtype.kind in "iu" and bool(np.array_equal(a, b))
+
+
 def _default_same(a, b, arguments):
     return same(a, b)
 

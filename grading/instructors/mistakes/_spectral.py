@@ -10,7 +10,15 @@ embedding by its eigenvalues and the product ``V V^T`` (a basis of an eigenspace
 
 import numpy as np
 
-from grading.instructors.mistakes import Mistake, Model, Variants, valid_integer, valid_points, valid_positive
+from grading.instructors.mistakes import (
+    Mistake,
+    Model,
+    Variants,
+    same_integers,
+    valid_integer,
+    valid_points,
+    valid_positive,
+)
 
 MAX_GRAPH_POINTS = 4_000  # the truth's dense N x N distances
 MAX_EIGEN_POINTS = 2_000  # the truth's dense eigh
@@ -293,11 +301,7 @@ def _clustering(**flags):
 
 
 def _labels_same(a, b, arguments):
-    try:
-        a, b = np.asarray(a), np.asarray(b)
-    except (TypeError, ValueError):
-        return False
-    return a.shape == b.shape and a.dtype.kind in "iu" and b.dtype.kind in "iu" and bool(np.array_equal(a, b))
+    return same_integers(a, b)
 
 
 def _first_appearance(labels):

@@ -19,7 +19,7 @@ import numbers
 
 import numpy as np
 
-from grading.instructors.mistakes import RANDOM, Mistake, Model, Variants, valid_integer, valid_points
+from grading.instructors.mistakes import RANDOM, Mistake, Model, Variants, same_integers, valid_integer, valid_points
 from grading.instructors.mistakes._density import DBSCAN, EUCLIDEAN_CLUSTERS
 from grading.instructors.mistakes._mixture import GMM_EM
 from grading.instructors.mistakes._spectral import KNN_GRAPH, SPECTRAL_CLUSTERING, SPECTRAL_EMBEDDING
@@ -133,16 +133,6 @@ def _close(a, b, scale):
     return bool(np.allclose(a, b, rtol=RTOL, atol=RTOL * scale, equal_nan=True))
 
 
-def _exact_integers(a, b):
-    try:
-        a, b = np.asarray(a), np.asarray(b)
-    except Exception:
-        return False
-    if a.shape != b.shape or a.dtype.kind not in "iu" or b.dtype.kind not in "iu":
-        return False
-    return bool(np.array_equal(a, b))
-
-
 def kmeans_same(a, b, arguments):
     """Labels and n_iter exactly; centres and inertia to a relative 1e-12 (their sums' order is free)."""
     if not (isinstance(a, tuple) and isinstance(b, tuple) and len(a) == len(b) == 4):
@@ -158,7 +148,7 @@ def kmeans_same(a, b, arguments):
         same_count = int(a[3]) == int(b[3]) and not isinstance(a[3], (bool, float, np.floating))
     except (TypeError, ValueError):
         return False
-    return _exact_integers(a[0], b[0]) and _close(a[1], b[1], scale) and _close(a[2], b[2], scale**2 * n) and same_count
+    return same_integers(a[0], b[0]) and _close(a[1], b[1], scale) and _close(a[2], b[2], scale**2 * n) and same_count
 
 
 KMEANS = Model(
