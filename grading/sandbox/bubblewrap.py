@@ -18,6 +18,7 @@ from functools import cache
 from pathlib import Path
 
 from grading import config
+from grading.sandbox.worker import SYSTEM_LIBRARIES
 
 WORKER = Path(__file__).with_name("worker.py")  # the script a worker runs
 PROTOCOL = Path(__file__).with_name("protocol.py")  # the wire format, beside it in every staging folder
@@ -109,8 +110,9 @@ def _masked_entries(site, extra=()):
 
 
 def _system_roots():
-    """The system's library folders that exist here (bound into the sandbox as they are)."""
-    return [path for path in ("/usr/lib", "/usr/lib64", "/usr/lib32") if Path(path).is_dir()]
+    """The system's library folders that exist here (bound into the sandbox as they are; the
+    worker's Landlock rules grant the same, :data:`grading.sandbox.worker.SYSTEM_LIBRARIES`)."""
+    return [path for path in SYSTEM_LIBRARIES if Path(path).is_dir()]
 
 
 def _import_roots():
@@ -146,7 +148,9 @@ def _environment_binds(extra=()):
     options = []
     for source in _system_roots():
         options += ["--ro-bind", source, source, "--symlink", f"usr/{Path(source).name}", f"/{Path(source).name}"]
-    options += ["--ro-bind-try", "/etc/ld.so.cache", "/etc/ld.so.cache"]
+    for source in SYSTEM_LIBRARIES:
+        if Path(source).is_file():
+            options += ["--ro-bind", source, source]  # the loader's cache
     roots = _import_roots()
     for source, target in roots[len(_system_roots()) :]:
         options += ["--ro-bind", str(source), target]

@@ -96,7 +96,9 @@ class Worker:
             network = "namespace"
         else:
             network = "required" if self.uid is not None else "optional"
-        tail = [",".join((*config.FORBIDDEN_PACKAGES, *self.extra)), network, str(self.exchange)]
+        # Landlock where the probe measured it (the uid level): the worker then refuses to run without it.
+        files = "landlock" if self.isolation.level == UID and not self.isolation.files_open else "open"
+        tail = [",".join((*config.FORBIDDEN_PACKAGES, *self.extra)), network, str(self.exchange), files]
         if self.isolation.level == BUBBLEWRAP:
             return bubblewrap_command(self.staged_root, tail, self.extra), {}
         python = [

@@ -16,7 +16,12 @@
     earlier results; ``batch``'s class folder and reports: :func:`protect`)
     cannot be read (:func:`permission_wall`),
     and that a seccomp filter closes the network (:func:`network_wall`; the
-    worker refuses to run without it). Everything that uid left running is
+    worker refuses to run without it). Where the kernel has Landlock (and the
+    container lets it be used), the same probe measures that the worker can
+    confine its files to the interpreter, the environment, the system's
+    libraries, the submission and its home; the worker then refuses to run
+    without it, and a world-readable file elsewhere (another copy of the
+    course) is out of its reach too. Without it, the level says so. Everything that uid left running is
     killed after each worker, and every file it owns in the world-writable
     folders is removed before and after each submission
     (:func:`remove_files_of`).
@@ -87,6 +92,7 @@ class Isolation:
     level: str
     uid: int = None
     reason: str = ""
+    files_open: str = ""  # the uid level: why Landlock does not confine its files ("": it does)
 
     @property
     def isolated(self):
@@ -97,9 +103,14 @@ class Isolation:
             who = f"uid {self.uid}" if self.uid is not None else "the grader's user"
             return f"isolated: bubblewrap sandbox (no network, no files of the grader's), as {who}"
         if self.level == UID:
+            files = (
+                "files confined by Landlock to the interpreter, its libraries and the submission"
+                if not self.files_open
+                else f"other world-readable files of the machine readable ({self.files_open})"
+            )
             return (
                 f"isolated: dedicated uid {self.uid} that cannot read the grader's files, network and new "
-                f"processes closed by a seccomp filter; no namespaces ({self.reason})"
+                f"processes closed by a seccomp filter, {files}; no namespaces ({self.reason})"
             )
         return f"NOT ISOLATED ({self.reason}): this is a local check, not a mark"
 
@@ -379,14 +390,20 @@ def permission_wall(uid, protected):
 
 
 def network_wall(uid):
-    """None if a worker running as ``uid`` can close its network (seccomp), else why not.
+    """Whether a worker running as ``uid`` can close its network (seccomp) and confine its files
+    (Landlock): ``(None or why not, None or why not)``.
 
     Run as ``uid`` with the worker's own code (``--check-network``): the
-    socket it then fails to open is measured, not assumed.
+    socket it then fails to open and the world-readable file outside its
+    paths that it fails to read are measured, not assumed.
     """
     folder = tempfile.mkdtemp(prefix="grading-network-")  # the course's copy is out of the uid's reach
-    os.chmod(folder, 0o755)
+    canary = tempfile.mkdtemp(prefix="grading-canary-")
+    for path in (folder, canary):
+        os.chmod(path, 0o755)
     os.chmod(shutil.copy(WORKER, folder), 0o644)
+    Path(canary, "readable-by-all").write_text("a file every user may read\n")
+    os.chmod(Path(canary, "readable-by-all"), 0o644)
     try:
         completed = subprocess.run(
             [
@@ -396,6 +413,7 @@ def network_wall(uid):
                 f"{folder}/{WORKER.name}",
                 "--check-network",
                 str(site_packages()),
+                str(Path(canary, "readable-by-all")),
             ],
             capture_output=True,
             text=True,
@@ -406,14 +424,16 @@ def network_wall(uid):
         )
         answer = json.loads(completed.stdout.strip().splitlines()[-1])
     except (OSError, subprocess.SubprocessError) as exc:
-        return f"the network could not be closed: the check failed ({exc})"
+        return f"the network could not be closed: the check failed ({exc})", "not checked"
     except (ValueError, IndexError):
         why = (completed.stderr.strip().splitlines() or ["no output"])[-1]
-        return f"the network could not be closed: the check failed ({why})"
+        return f"the network could not be closed: the check failed ({why})", "not checked"
     finally:
         kill_uid(uid)
         shutil.rmtree(folder, ignore_errors=True)
-    return None if answer.get("closed") else f"the network could not be closed: {answer.get('why')}"
+        shutil.rmtree(canary, ignore_errors=True)
+    network = None if answer.get("closed") else f"the network could not be closed: {answer.get('why')}"
+    return network, answer.get("files")
 
 
 @cache
@@ -461,7 +481,7 @@ def isolation(uid=None):
             )
     if wall is not None:
         return Isolation(NONE, None, f"{why_not}; {wall}")
-    network = network_wall(uid)
+    network, files = network_wall(uid)
     if network is not None:
         return Isolation(NONE, None, f"{why_not}; {network}")
-    return Isolation(UID, uid, why_not)
+    return Isolation(UID, uid, why_not, files_open=files or "")

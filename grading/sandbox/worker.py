@@ -25,11 +25,17 @@ dedicated uid without namespaces (a Docker container) the filter is the
 wall, and the worker refuses to run without it; under bubblewrap the empty
 network namespace is.
 
-Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES NETWORK EXCHANGE_FD
+As a dedicated uid it also confines its files with Landlock
+(:func:`restrict_files`), where the kernel has it: it reads the interpreter,
+the environment, the system's libraries and the staged submission, and writes
+its home only, whatever else of the machine is world-readable.
+
+Usage: python -I -S worker.py SITE_PACKAGES SUBMISSION_DIR FORBIDDEN_PACKAGES NETWORK EXCHANGE_FD FILES
 (FORBIDDEN_PACKAGES comma-separated dotted names, from grading.config; NETWORK is
 ``required`` or ``optional``: whether the worker may run when the filter
 cannot be installed, or ``namespace``: no filter, bubblewrap's network
-namespace is the wall), or python -I -S worker.py --check-network SITE_PACKAGES.
+namespace is the wall; FILES is ``landlock``, required, or ``open``), or
+python -I -S worker.py --check-network SITE_PACKAGES CANARY.
 """
 
 import errno
@@ -97,9 +103,108 @@ def close_network():
     return None
 
 
-def _check_network(site_packages):
+# Landlock (<linux/landlock.h>): the same syscall numbers on every architecture.
+_CREATE_RULESET, _ADD_RULE, _RESTRICT_SELF = 444, 445, 446
+_RULESET_VERSION, _RULE_PATH_BENEATH = 1, 1
+_EXECUTE, _WRITE_FILE, _READ_FILE, _READ_DIR = 1, 2, 4, 8
+_TRUNCATE, _IOCTL_DEV = 1 << 14, 1 << 15
+_FILE_RIGHTS = _EXECUTE | _WRITE_FILE | _READ_FILE | _TRUNCATE | _IOCTL_DEV  # the rights a file's rule can hold
+_READ = _EXECUTE | _READ_FILE | _READ_DIR
+
+# The loader's folders and cache (bubblewrap binds the same: grading.sandbox.bubblewrap).
+SYSTEM_LIBRARIES = ("/usr/lib", "/usr/lib64", "/usr/lib32", "/etc/ld.so.cache")
+# Read: the CPUs' description (sysconf, OpenBLAS) and the worker's own /proc/<pid> (glibc reads
+# /proc/self/maps); written: /dev/null, and /dev/shm (multiprocessing's semaphores), which the
+# grader empties after each submission like /tmp.
+_DEVICES_READ = ("/sys/devices/system/cpu", "/proc/self", "/dev/urandom", "/dev/zero")
+_DEVICES_WRITTEN = ("/dev/null", "/dev/shm")
+
+
+def _handled_rights(abi):
+    """Every filesystem right this kernel's Landlock ABI knows (all of them are then denied
+    unless a rule grants them)."""
+    rights = (1 << 13) - 1  # ABI 1: execute .. make_sym
+    if abi >= 2:
+        rights |= 1 << 13  # refer (links and renames across folders)
+    if abi >= 3:
+        rights |= _TRUNCATE
+    if abi >= 5:
+        rights |= _IOCTL_DEV
+    return rights
+
+
+def restrict_files(readable, writable):
+    """Confine this process and all it starts with Landlock: ``readable`` paths (and what lies
+    below them) can be read and run, ``writable`` ones written too, nothing else of the machine
+    can be touched, whatever its mode bits; and, where the kernel knows them, no TCP, no
+    abstract unix socket and no signal outside the sandbox.
+
+    Unprivileged and without namespaces: what the uid mode (a container that forbids namespaces)
+    lacked, where a submission could read any world-readable file (another copy of the course,
+    say). Needs ``no_new_privs``, which :func:`close_network` sets. Paths that do not exist are
+    skipped. Returns None when in place; else why not (an old kernel, a container that refuses
+    the calls).
+    """
+    import ctypes
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    libc.syscall.restype = ctypes.c_long
+
+    def call(*args):
+        result = libc.syscall(*(ctypes.c_long(a) if isinstance(a, int) else a for a in args))
+        if result < 0:
+            raise OSError(ctypes.get_errno(), os.strerror(ctypes.get_errno()))
+        return result
+
+    class Ruleset(ctypes.Structure):
+        _fields_ = [("fs", ctypes.c_uint64), ("net", ctypes.c_uint64), ("scoped", ctypes.c_uint64)]
+
+    class PathBeneath(ctypes.Structure):
+        _pack_ = 1
+        _fields_ = [("allowed", ctypes.c_uint64), ("fd", ctypes.c_int32)]
+
+    try:
+        abi = call(_CREATE_RULESET, None, 0, _RULESET_VERSION)
+        handled = _handled_rights(abi)
+        attributes = Ruleset(handled, 3 if abi >= 4 else 0, 3 if abi >= 6 else 0)  # TCP bind, connect; scopes
+        ruleset = call(_CREATE_RULESET, ctypes.byref(attributes), ctypes.sizeof(attributes), 0)
+        try:
+            grants = [(path, _READ) for path in readable] + [(path, handled) for path in writable]
+            for path, rights in grants:
+                try:
+                    fd = os.open(path, os.O_PATH | os.O_CLOEXEC)
+                except OSError:
+                    continue  # not on this machine
+                try:
+                    if not os.path.isdir(path):
+                        rights &= _FILE_RIGHTS
+                    rule = PathBeneath(rights & handled, fd)
+                    call(_ADD_RULE, ruleset, _RULE_PATH_BENEATH, ctypes.byref(rule), 0)
+                finally:
+                    os.close(fd)
+            call(_RESTRICT_SELF, ruleset, 0)
+        finally:
+            os.close(ruleset)
+    except OSError as exc:
+        return f"no Landlock ({exc.strerror or exc})"
+    return None
+
+
+def landlocked_paths(site_packages, submission, home):
+    """(readable, writable) for :func:`restrict_files`: the interpreter's libraries, the
+    environment's site-packages, the system's libraries, the staged submission (with this
+    script) and the worker's home."""
+    base = os.path.realpath(os.path.join(sys.base_prefix, "lib"))
+    readable = [base, os.path.realpath(site_packages), *SYSTEM_LIBRARIES, *_DEVICES_READ, submission]
+    return readable, [home, *_DEVICES_WRITTEN]
+
+
+def _check_network(site_packages, canary):
     """Measure, do not infer: after :func:`close_network`, a socket and a new process must be
-    refused, and a thread must still start."""
+    refused, and a thread must still start; then, under :func:`restrict_files`, ``canary`` (a
+    world-readable file outside the paths it grants) must be unreadable and the environment's
+    site-packages readable. Prints ``closed`` (the network), ``why`` and ``files`` (None: the
+    files are confined; else why not)."""
     import socket
     import subprocess
     import threading
@@ -132,7 +237,21 @@ def _check_network(site_packages):
             thread.join()
         except RuntimeError as exc:
             why_not = f"a thread could not start under the seccomp filter ({exc})"
-    print(json.dumps({"closed": why_not is None, "why": why_not}))
+    here = os.path.dirname(os.path.abspath(__file__))
+    files = restrict_files(*landlocked_paths(site_packages, here, here)) if why_not is None else "not tried"
+    if files is None:
+        try:
+            open(canary).close()
+            files = f"{canary} could still be read under Landlock"
+        except PermissionError:
+            pass
+    if files is None:
+        try:
+            os.listdir(site_packages)
+            import decimal  # noqa: F401 -- a module of the standard library, with its C part, still loads
+        except OSError as exc:
+            files = f"the environment could not be read under Landlock ({exc})"
+    print(json.dumps({"closed": why_not is None, "why": why_not, "files": files}))
 
 
 def _generators(value, path, np):
@@ -238,9 +357,10 @@ def _call(request, wire, sender, np, exchange=None):
 
 def main():
     if sys.argv[1] == "--check-network":
-        return _check_network(sys.argv[2])
+        return _check_network(sys.argv[2], sys.argv[3])
     site_packages, submission, forbidden, network = sys.argv[1], sys.argv[2], sys.argv[3].split(","), sys.argv[4]
     exchange = int(sys.argv[5]) if len(sys.argv) > 5 else None
+    files = sys.argv[6] if len(sys.argv) > 6 else "open"
     answers = os.fdopen(os.dup(1), "wb", buffering=0)
     os.dup2(2, 1)  # the submission's prints go to stderr, not into the protocol
     sys.stdout = sys.stderr
@@ -254,6 +374,12 @@ def main():
     if why_not is not None and network == "required":
         sender.send({"ready": False, "error": f"the network could not be closed: {why_not}"})
         return
+    if files == "landlock":  # the grader measured that Landlock works here: required
+        home = os.environ.get("HOME") or os.getcwd()
+        why_not = restrict_files(*landlocked_paths(site_packages, os.path.dirname(os.path.abspath(__file__)), home))
+        if why_not is not None:
+            sender.send({"ready": False, "error": f"the files could not be confined: {why_not}"})
+            return
     sys.meta_path.insert(0, _ForbiddenImports(forbidden))
     sys.path.insert(0, submission)
     import numpy as np

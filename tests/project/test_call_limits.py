@@ -423,11 +423,11 @@ HOARDERS = textwrap.dedent(
 
     def deleted(count, mib, seconds):
         # Files deleted while open: no walk of the folders finds them, no mapping shows them.
-        held = []
+        held, folder = [], os.environ.get("TMPDIR", "/tmp")  # the worker's own: writable under Landlock too
         for i in range(count):
-            handle = open(f"/tmp/hoard{i}", "wb")
+            handle = open(f"{folder}/hoard{i}", "wb")
             os.posix_fallocate(handle.fileno(), 0, mib * 2**20)
-            os.unlink(f"/tmp/hoard{i}")
+            os.unlink(f"{folder}/hoard{i}")
             held.append(handle)
         time.sleep(seconds)
         return np.array([len(held)])

@@ -259,7 +259,11 @@ def chamfer_distance(a, b):
     except BaseException as exc:
         found["package"] = type(exc).__name__
     # Every command line this uid can read: none may name where the submission or its results are.
-    for pid in os.listdir("/proc"):
+    try:
+        processes = os.listdir("/proc")
+    except OSError:  # Landlock: not even the list
+        processes = []
+    for pid in processes:
         try:
             with open(f"/proc/{pid}/cmdline", "rb") as handle:
                 line = handle.read().replace(b"\\0", b" ").decode(errors="replace")
@@ -314,13 +318,26 @@ def test_the_platforms_files_and_earlier_results_are_out_of_reach(archive, tmp_p
     for path in (root, metadata, root / "submission", root / "results"):
         path.chmod(0o755 if path.is_dir() else 0o644)
     make_reachable(root / "results")
-    readable = [str(metadata), str(root / "results"), str(root / "submission"), str(root)]
+    # Another copy of the course on the machine, readable by all (a clone an instructor left):
+    # bubblewrap binds nothing of it; as a dedicated uid, Landlock keeps it out of reach.
+    elsewhere = tmp_path / "another-clone" / "solutions" / "metrics.py"
+    elsewhere.parent.mkdir(parents=True)
+    elsewhere.write_text("def chamfer_distance(a, b): ...\n")
+    for path in (elsewhere, elsewhere.parent, elsewhere.parent.parent):
+        path.chmod(0o755 if path.is_dir() else 0o644)
+    make_reachable(elsewhere)
+    readable = [str(metadata), str(root / "results"), str(root / "submission"), str(root), str(elsewhere)]
     (root / "submission" / "metrics.py").write_text(SPY % {"readable": readable, "writable": [], "port": 9})
     results, _ = run_autograder(root, namespaces=namespaces)
     outputs = [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance" and "SPY" in t["text"]]
     assert outputs, [t["text"] for t in results["tests"] if t["tags"][0] == "chamfer_distance"]
     found = json.loads(outputs[0][outputs[0].index("SPY") + 3 : outputs[0].index("YPS")])
-    assert found["readable"] == [], found
+    isolation = results["grading"].isolation
+    if "world-readable files of the machine readable" in isolation:  # a kernel without Landlock: said, not hidden
+        assert found["readable"] == [str(elsewhere)], found
+    else:
+        assert found["readable"] == [], found
+        assert namespaces or "confined by Landlock" in isolation, isolation
 
 
 def test_the_permission_probe_checks_the_platforms_folder(tmp_path, monkeypatch):
