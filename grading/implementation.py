@@ -58,14 +58,22 @@ def _private_copy(value):
 def _first_line(text, limit=200):
     """The first line of ``str(text)``, at most ``limit`` characters: what a one-line diagnosis may quote
     of an exception's message or place (both the submission's)."""
+    if text is None:
+        return ""
     return (str(text).splitlines() or [""])[0][:limit]
+
+
+def same_bits(before, after):
+    """Whether an array is unchanged, bit for bit: 0.0 made -0.0 is a change, a NaN left alone is not."""
+    if before.dtype.kind == "O" or after.dtype.kind == "O":  # references, not values: compared as values
+        return before.shape == after.shape and np.array_equal(before, after)
+    return before.dtype == after.dtype and before.shape == after.shape and before.tobytes() == after.tobytes()
 
 
 def _modified(before, after, path=()):
     """Paths of the arrays of ``after`` that differ from those of ``before`` (same structure)."""
     if type(before) is np.ndarray:
-        same = before.shape == after.shape and np.array_equal(before, after, equal_nan=before.dtype.kind in "fc")
-        return [] if same else [list(path)]
+        return [] if same_bits(before, after) else [list(path)]
     if type(before) in (tuple, list):
         return [p for i, (b, a) in enumerate(zip(before, after)) for p in _modified(b, a, (*path, i))]
     if type(before) is dict:

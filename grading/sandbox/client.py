@@ -372,8 +372,7 @@ class Worker:
             if len(data) != value.nbytes:  # the file was cut short: the memory was changed
                 changed.append(path)
                 continue
-            after = np.frombuffer(data, dtype=value.dtype).reshape(value.shape)
-            if not np.array_equal(after, value, equal_nan=value.dtype.kind in "fc"):
+            if data != np.ascontiguousarray(value).tobytes():  # bit for bit: 0.0 made -0.0 is a change
                 changed.append(path)
         return changed
 

@@ -19,6 +19,7 @@ from _helpers import hidden_tests, public_tests, run_grader
 
 from grading import REPO_ROOT
 from grading.config import MAX_OUTPUT
+from grading.implementation import _first_line
 from grading.results import Grading, TestResult, clean, fenced
 
 needs_root = pytest.mark.skipif(os.geteuid() != 0, reason="needs root (the uid mode)")
@@ -116,6 +117,8 @@ def test_the_sanitiser_on_its_own():
     assert clean("a\x1bb\x07c\u202ed\u200be\n", newlines=False) == "a\\x1bb\\x07c\\u202ed\\u200be\\n"
     assert clean("x" * 10_000, limit=50).endswith("...") and len(clean("x" * 10_000, limit=50)) == 50
     assert fenced("a ``` b ```` c").startswith("`````text\n")
+    assert _first_line(None) == ""  # no place known: "every call raised SandboxError", never "... at None"
+    assert _first_line("a\nb" + "c" * 300) == "a" and len(_first_line("c" * 300)) == 200
     result = TestResult("t", "1.1", "pca", 1.0)
     result.set_feedback("line\n" * 100)
     assert len(result.feedback.splitlines()) <= 15 and result.feedback.endswith("more lines)")

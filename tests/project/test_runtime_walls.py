@@ -25,6 +25,7 @@ from _helpers import run_grader
 
 from grading import REPO_ROOT
 from grading.errors import ForbiddenAPI, SandboxError
+from grading.implementation import _call_on_copies
 from grading.sandbox import UID, Isolation, Worker, reserve_uid
 from grading.sandbox.walls import bar_forbidden_packages
 from grading.staging import stage
@@ -356,6 +357,46 @@ def test_the_in_place_verdict_is_the_graders_whatever_the_worker_rewrites(tmp_pa
         readonly.flags.writeable = False  # numpy's flag can be set back by the function: the verdict holds
         impl.call("pca", "pca", (readonly,), {})
         assert impl.last_modified == [["args", 0]]
+    finally:
+        impl.close()
+
+
+SIGNED_ZEROS = """
+import numpy as np
+
+
+def signed_zeros(points):
+    points[points == 0] = -0.0  # equal as numbers, not as bits: the caller's array changed
+    return np.zeros(1)
+
+
+def same_values(points):
+    points[...] = points.copy()  # written, but every bit as it was (NaNs included)
+    return np.zeros(1)
+"""
+
+
+@pytest.mark.parametrize("level", [*LEVELS, "in-process"])
+def test_an_in_place_change_is_a_change_of_bits(tmp_path, level):
+    """0.0 made -0.0 compares equal but is a change; rewriting the same values (NaNs too) is not."""
+    points = np.array([[0.0, 1.0, np.nan], [2.0, 0.0, 3.0]])
+    if level == "in-process":
+        namespace = {}
+        exec(SIGNED_ZEROS, namespace)
+        assert _call_on_copies(namespace["signed_zeros"], (points,), {})[1] == [["args", 0]]
+        assert _call_on_copies(namespace["same_values"], (points,), {})[1] == []
+        return
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "pca.py").write_text(SIGNED_ZEROS)
+    isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
+    impl = Worker(stage(package).root, timeout=20, level=isolated)
+    try:
+        impl.call("pca", "signed_zeros", (points,), {})
+        assert impl.last_modified == [["args", 0]]
+        impl.call("pca", "same_values", (points,), {})
+        assert impl.last_modified == []
     finally:
         impl.close()
 
