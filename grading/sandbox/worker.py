@@ -63,15 +63,45 @@ class _ForbiddenImports:
 
 
 CLONE_THREAD = 0x00010000  # <linux/sched.h>: a clone that makes a thread, not a process
+SOCK_STREAM, SOCK_SEQPACKET = 1, 5  # <linux/net.h>: the socket pairs that cannot address anything else
+# Every call the filter fails with EACCES. Sockets (io_uring can open them); kernel objects that
+# outlive their processes, out of reach of the grader's cleanup of a uid's files and processes
+# (SysV IPC; a uid's keyrings, which the next submission run as that uid would find); watches
+# that report other users' file activity (inotify, fanotify); naming or reaching a socket by a
+# path (bind, connect, listen on a socket pair); and every new process.
+_DENIED_CALLS = (
+    "socket",
+    "io_uring_setup",
+    "shmget",
+    "msgget",
+    "semget",
+    "add_key",
+    "request_key",
+    "keyctl",
+    "inotify_init",
+    "inotify_init1",
+    "fanotify_init",
+    "bind",
+    "connect",
+    "listen",
+    "execve",
+    "execveat",
+    "fork",
+    "vfork",
+)
 
 
 def close_network():
     """Install a seccomp filter that fails every ``socket()`` (any address
-    family; ``socketpair()`` stays) and ``io_uring_setup()`` (io_uring can
+    family; ``socketpair()`` of a stream or a sequenced-packet pair stays,
+    which can reach no other socket) and ``io_uring_setup()`` (io_uring can
     open sockets) with ``EACCES``, for this process and all it starts; and
-    ``shmget``, ``msgget`` and ``semget`` (SysV IPC objects outlive their
-    processes; POSIX shared memory is a file in ``/dev/shm``, counted and
-    removed like the others); and every new process: ``execve``,
+    ``bind``, ``connect``, ``listen`` (a datagram pair could otherwise send
+    to any socket named by a path); ``shmget``, ``msgget`` and ``semget``
+    (SysV IPC objects outlive their processes) and ``add_key``,
+    ``request_key``, ``keyctl`` (a uid's keyrings outlive them too); the
+    watches ``inotify_init``, ``inotify_init1`` and ``fanotify_init``, which
+    report other users' file activity; and every new process: ``execve``,
     ``execveat``, ``fork``, ``vfork`` and a ``clone`` without
     ``CLONE_THREAD`` (threads stay), ``clone3`` with ``ENOSYS`` (glibc then
     falls back to ``clone``). A process of the submission's own would run
@@ -91,10 +121,11 @@ def close_network():
         import pyseccomp as seccomp  # libseccomp's Python API, over ctypes
 
         deny = seccomp.SyscallFilter(seccomp.ALLOW)
-        # SysV IPC objects outlive every process that made them (and, as a uid's, reach the next
-        # submission): refused too. Bubblewrap's IPC namespace dies with the sandbox instead.
-        for call in ("socket", "io_uring_setup", "shmget", "msgget", "semget", "execve", "execveat", "fork", "vfork"):
+        for call in _DENIED_CALLS:
             deny.add_rule(seccomp.ERRNO(errno.EACCES), call)
+        for kind in range(16):  # socketpair's type, its flags masked off: a stream or a sequenced pair only
+            if kind not in (SOCK_STREAM, SOCK_SEQPACKET):
+                deny.add_rule(seccomp.ERRNO(errno.EACCES), "socketpair", seccomp.Arg(1, seccomp.MASKED_EQ, 0xF, kind))
         deny.add_rule(seccomp.ERRNO(errno.EACCES), "clone", seccomp.Arg(0, seccomp.MASKED_EQ, CLONE_THREAD, 0))
         deny.add_rule(seccomp.ERRNO(errno.ENOSYS), "clone3")  # its flags are in memory: no rule can read them
         deny.load()  # sets no_new_privs first
@@ -113,11 +144,21 @@ _READ = _EXECUTE | _READ_FILE | _READ_DIR
 
 # The loader's folders and cache (bubblewrap binds the same: grading.sandbox.bubblewrap).
 SYSTEM_LIBRARIES = ("/usr/lib", "/usr/lib64", "/usr/lib32", "/etc/ld.so.cache")
-# Read: the CPUs' description (sysconf, OpenBLAS) and the worker's own /proc/<pid> (glibc reads
-# /proc/self/maps); written: /dev/null, and /dev/shm (multiprocessing's semaphores), which the
-# grader empties after each submission like /tmp.
-_DEVICES_READ = ("/sys/devices/system/cpu", "/proc/self", "/dev/urandom", "/dev/zero")
-_DEVICES_WRITTEN = ("/dev/null", "/dev/shm")
+# Read: the machine's CPUs and memory (sysconf, OpenBLAS, libraries that size their work), the
+# time zone, and the worker's own /proc/<pid> entries that a process reads of itself (glibc reads
+# maps), not the rest (its net/ and mountinfo describe the host). Written: /dev/null only; not
+# /dev/shm, shared by every slot graded at once (no process can be started to share a semaphore).
+_DEVICES_READ = (
+    "/sys/devices/system/cpu",
+    "/proc/cpuinfo",
+    "/proc/meminfo",
+    *(f"/proc/self/{entry}" for entry in ("maps", "stat", "statm", "status", "fd", "task", "cgroup")),
+    "/etc/localtime",
+    "/usr/share/zoneinfo",
+    "/dev/urandom",
+    "/dev/zero",
+)
+_DEVICES_WRITTEN = ("/dev/null",)
 
 
 def _handled_rights(abi):

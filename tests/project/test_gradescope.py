@@ -299,10 +299,13 @@ def test_the_sandbox_uid_reaches_no_forbidden_package_no_path_and_leaves_nothing
     found = json.loads(outputs[0][outputs[0].index("SPY") + 3 : outputs[0].index("YPS")])
     assert found["package"] in ("ModuleNotFoundError", "ImportError", "PermissionError"), found
     assert found["command_lines"] == [], found
-    assert found["left"], "the submission could write nowhere: the check above proves nothing"
+    isolation = results["grading"].isolation
+    if "confined by Landlock" in isolation:  # nothing outside the worker's own home is writable
+        assert found["left"] == [], found
+    else:
+        assert found["left"], "the submission could write nowhere: the check above proves nothing"
     left = [f"{folder}/pcl-token-{token}" for folder in ("/tmp", "/var/tmp", "/dev/shm")]
     assert not [path for path in left if os.path.lexists(path)]
-    isolation = results["grading"].isolation
     assert isolation.startswith("isolated: bubblewrap" if namespaces else "isolated: dedicated uid"), isolation
 
 

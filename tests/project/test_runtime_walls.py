@@ -401,6 +401,63 @@ def test_an_in_place_change_is_a_change_of_bits(tmp_path, level):
         impl.close()
 
 
+LINGERING = """
+import ctypes
+import os
+import socket
+
+import numpy as np
+
+
+def reach():
+    \"\"\"What a submission could leave for the next one run as its uid, or watch of other users'.\"\"\"
+    libc = ctypes.CDLL(None, use_errno=True)
+    found = {}
+    # A key in the uid's own keyring (add_key: 248 on x86-64), which outlives every process.
+    key = libc.syscall(248, b"user", b"left-for-the-next", b"data", 4, -4)  # -4: KEY_SPEC_USER_KEYRING
+    found["add_key"] = "refused" if key < 0 and ctypes.get_errno() == 13 else f"made {key}"
+    # Watches on other users' folders, which report the files they open.
+    watch = libc.inotify_init1(0)
+    found["inotify"] = "refused" if watch < 0 and ctypes.get_errno() == 13 else "made"
+    # A datagram pair, which can send to any socket named by a path.
+    try:
+        socket.socketpair(socket.AF_UNIX, socket.SOCK_DGRAM)
+        found["datagram pair"] = "made"
+    except PermissionError:
+        found["datagram pair"] = "refused"
+    socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)  # a stream pair stays: it reaches nothing else
+    try:
+        with open("/dev/shm/left-for-the-next", "w"):
+            found["/dev/shm"] = "written"
+    except PermissionError:
+        found["/dev/shm"] = "refused"
+    try:
+        open("/proc/self/mountinfo").close()
+        found["mountinfo"] = "read"
+    except PermissionError:
+        found["mountinfo"] = "refused"
+    open("/proc/self/maps").close()  # what a process reads of itself stays
+    return np.array([int(v == "refused") for v in found.values()]), found
+"""
+
+
+@pytest.mark.skipif(os.geteuid() != 0 or os.uname().machine != "x86_64", reason="the uid mode needs root; x86-64")
+def test_as_a_dedicated_uid_nothing_is_left_for_the_next_submission_or_watched(tmp_path):
+    """Helper h58's review of the uid mode: a key in the uid's keyring outlived the submission and
+    the next one read it; inotify reported other users' file activity; a datagram socket pair sent
+    to a path outside; /dev/shm is shared by the slots graded at once; mountinfo describes the host."""
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "pca.py").write_text(LINGERING)
+    impl = Worker(stage(package).root, timeout=20, level=Isolation(UID, reserve_uid(), "test"))
+    try:
+        refused, found = impl.call("pca", "reach", (), {})
+    finally:
+        impl.close()
+    assert set(found.values()) == {"refused"}, found
+
+
 def test_a_pca_that_hides_its_in_place_change_loses_the_point(tmp_path):
     package = tmp_path / "clone" / "pcl_course"
     shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
@@ -433,9 +490,8 @@ def test_the_mapped_files_name_the_forbidden_package_a_process_holds():
 
 @pytest.mark.skipif(os.geteuid() != 0, reason="the uid mode needs root")
 def test_the_rules_uid_finds_nothing_the_slots_other_uid_left(tmp_path):
-    """pca.py (the slot's uid, which may read scipy.spatial) could copy it to /dev/shm (writable
-    under Landlock too) for nn.py (the slot's second uid, barred from it): the other uid's files
-    are removed before the switch."""
+    """pca.py (the slot's uid, which may read scipy.spatial) could copy it to /tmp for nn.py (the
+    slot's second uid, barred from it): the other uid's files are removed before the switch."""
     package = tmp_path / "clone" / "pcl_course"
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
@@ -445,8 +501,11 @@ def test_the_rules_uid_finds_nothing_the_slots_other_uid_left(tmp_path):
         "    os.chmod(name, 0o644)\n    return 1\n"
     )
     (package / "nn.py").write_text("import os\n\ndef find(name):\n    return int(os.path.exists(name))\n")
-    impl = Worker(stage(package).root, timeout=20, level=Isolation(UID, reserve_uid(), "test"))
-    name = f"/dev/shm/left-by-pca-{os.getpid()}"
+    # Without Landlock (a kernel that lacks it), where /tmp is writable: under it nothing outside
+    # the worker's own home is (test_as_a_dedicated_uid_nothing_is_left_for_the_next_submission...).
+    isolated = Isolation(UID, reserve_uid(), "test", files_open="Landlock off for the test")
+    impl = Worker(stage(package).root, timeout=20, level=isolated)
+    name = f"/tmp/left-by-pca-{os.getpid()}"
     try:
         assert impl.call("pca", "leave", (name,), {}) == 1
         assert impl.call("nn", "find", (name,), {}) == 0
