@@ -53,6 +53,8 @@ __all__ = [
     "clustering_grid",
     "small_graph",
     "spectral_panels",
+    "mean_shift_paths",
+    "bandwidth_sweep",
 ]
 
 
@@ -1625,5 +1627,76 @@ def spectral_panels(points, indptr, indices, eigenvalues, rows, labels, figsize=
                   title="the rows of Y (jittered along the circle)")  # fmt: skip
     clusters.scatter(*points.T, s=4, c=colours, lw=0)
     clusters.set(aspect="equal", xticks=[], yticks=[], title="the labels")
+    fig.tight_layout()
+    plt.show()
+
+
+def mean_shift_paths(points, grid, density, paths, modes, bandwidth, figsize=(7.5, 5.6)):
+    """Mean-shift trajectories over the contours of a 2-D density estimate.
+
+    Parameters
+    ----------
+    points : array_like of shape (N, 2)
+        The data, drawn as small grey dots.
+    grid : tuple of (array_like of shape (G,), array_like of shape (H,))
+        The x and y coordinates at which ``density`` is given.
+    density : array_like of shape (H, G)
+        The density estimate on the grid (row ``j`` at ``grid[1][j]``).
+    paths : list of array_like of shape (T, 2)
+        Each seed's positions, its start first; drawn as a line with a dot per position.
+    modes : array_like of shape (M, 2)
+        Drawn as black crosses.
+    bandwidth : float
+        A circle of this radius around the start of the first path: the first window.
+    figsize : tuple of float, default (7.5, 5.6)
+    """
+    import matplotlib.pyplot as plt
+
+    points = np.asarray(points, dtype=float)
+    fig, ax = plt.subplots(figsize=figsize)
+    filled = ax.contourf(*grid, np.asarray(density, dtype=float), levels=12, cmap="Greys", alpha=0.55)
+    fig.colorbar(filled, ax=ax, label="Epanechnikov density estimate", shrink=0.8)
+    ax.scatter(*points.T, s=3, c="0.35", lw=0)
+    for k, path in enumerate(paths):
+        path = np.asarray(path, dtype=float)
+        ax.plot(*path.T, "-o", c=f"C{k % 10}", ms=3, lw=1.4)
+        ax.scatter(*path[0], s=50, facecolors="none", edgecolors=f"C{k % 10}", lw=1.5)
+    if paths:
+        ax.add_patch(plt.Circle(np.asarray(paths[0], dtype=float)[0], bandwidth, fill=False, ls="--", lw=1, ec="C0"))
+    ax.scatter(*np.asarray(modes, dtype=float).T, marker="X", s=110, c="k", ec="w", lw=1, zorder=5)
+    ax.set(aspect="equal", xlabel="x", ylabel="y")
+    fig.tight_layout()
+    plt.show()
+
+
+def bandwidth_sweep(bandwidths, counts, panels, figsize=(11, 7.2)):
+    """How many clusters mean shift finds against the bandwidth, and the clusters at a few bandwidths.
+
+    Parameters
+    ----------
+    bandwidths, counts : array_like of shape (B,)
+        The bandwidths tried and the number of clusters found at each (log-log axes).
+    panels : dict of float to (array_like of shape (N, 2), array_like of shape (N,), array_like of shape (K, 2))
+        Bandwidth -> the points, their labels and the modes, drawn in a row under the curve (and
+        marked on it).
+    figsize : tuple of float, default (11, 7.2)
+    """
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=figsize)
+    grid = fig.add_gridspec(2, len(panels), height_ratios=[1, 1.25])
+    top = fig.add_subplot(grid[0, :])
+    top.plot(bandwidths, counts, "-o", c="k", ms=3, lw=1.2)
+    for k, h in enumerate(panels):
+        top.axvline(h, c=f"C{k}", ls="--", lw=1)
+    top.set(xscale="log", yscale="log", xlabel="bandwidth h", ylabel="clusters found")
+    top.grid(alpha=0.3, which="both")
+    for k, (h, (points, labels, modes)) in enumerate(panels.items()):
+        ax = fig.add_subplot(grid[1, k])
+        points = np.asarray(points, dtype=float)
+        ax.scatter(*points.T, s=4, c=_cluster_colours(labels), lw=0)
+        ax.scatter(*np.asarray(modes, dtype=float).T, marker="X", s=60, c="k", ec="w", lw=0.8)
+        ax.set_title(f"h = {h:g}: {len(modes)} cluster{'s' if len(modes) != 1 else ''}", color=f"C{k}")
+        ax.set(aspect="equal", xticks=[], yticks=[])
     fig.tight_layout()
     plt.show()
