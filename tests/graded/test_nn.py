@@ -316,12 +316,14 @@ def test_bst_knn_tie_in_the_far_subtree(impl):
     # |10 - 9.5| = 0.5 <= w, so the right side is searched and node 1 evicts node 2: [0, 1].
     keys = np.array([10.0, 10.0, 9.0])
     left, right = bst_of(impl, keys)
-    indices, _ = impl.bst_knn(keys, left, right, 9.5, 2)
+    indices, distances = impl.bst_knn(keys, left, right, 9.5, 2)
     check_array(indices, "indices", shape=(2,), dtype=None)
     assert indices.tolist() == [0, 1], (
         f"expected [0, 1], got {indices.tolist()}: equal keys go right, so a tie at the k-th distance can lie "
         "on the far side; search it when |keys[j] - query| <= w (inclusive)"
     )
+    tie = np.array([[0, 1]])
+    check_knn(np.asarray(indices)[None], np.asarray(distances)[None], tie, np.array([[0.5, 0.5]]), "bst_knn")
 
 
 @pytest.mark.grades("bst_knn")
@@ -332,6 +334,8 @@ def test_bst_knn_on_a_path_of_sorted_keys(impl):
     indices, distances = impl.bst_knn(keys, left, right, 700.3, 3)
     check_array(indices, "indices", shape=(3,), dtype=None)
     assert indices.tolist() == [1401, 1400, 1402], "a path of depth 1499: search it with a loop or an explicit stack"
+    nearest = np.array([[1401, 1400, 1402]])
+    check_knn(np.asarray(indices)[None], np.asarray(distances)[None], nearest, np.abs(keys[nearest] - 700.3), "bst_knn")
 
 
 @pytest.mark.grades("bst_knn")

@@ -167,10 +167,12 @@ def test_bst_knn_hidden_reads_only_what_its_rule_reaches(impl):
             lying[unreached] = trees.decoy_places(query, gaps[k - 1] or nearest, len(unreached), rng)[:, 0]
             if pair is not None and partner == "unreached":  # U's decoy lies in C's interval: between the query
                 lying[pair[1]] = query + nearest * rng.uniform(0.01, 0.99)  # and the nearest key above or below
-            indices, _ = impl.bst_knn(lying, left, right, float(query), k)
+            indices, distances = impl.bst_knn(lying, left, right, float(query), k)
             expected = np.lexsort((np.arange(len(keys)), np.abs(trapped_keys - query)))[:k]
             if as_list(indices, k) != expected.tolist():
                 raise failure("bst_knn", indices, unreached, structure_failure("bst_knn"), expected, trapped)
+            expected_distances = np.abs(lying[expected] - query)  # of the keys it was given
+            check_knn(np.asarray(indices)[None], np.asarray(distances)[None], expected[None], expected_distances[None])
     assert traps >= 2 and own >= 2 and counters >= 2, "the test needs traps and counter-decoys on its queries"
 
 
