@@ -217,22 +217,49 @@ def euclidean_clusters(points, tolerance, min_size=1, max_size=None):
 
 
 _BLOCK = 1024  # rows of squared distances at a time: (1024, N) float64
+_SPARE = 8  # candidates a k-d tree gives beyond the k + 1 nearest (the point itself among them)
+
+
+def _brute_neighbours(points, rows, k):
+    """The k neighbours by ``(s, j)`` of the points ``rows``, each itself left out, from every
+    point's squared distance: (len(rows), k) int64."""
+    neighbours = np.empty((len(rows), k), dtype=np.int64)
+    for start in range(0, len(rows), _BLOCK):
+        block = rows[start : start + _BLOCK]
+        s = _squared_distances(points[block], points)
+        s[np.arange(len(block)), block] = np.inf  # the point itself, not its duplicates
+        kth = np.partition(s, k - 1, axis=1)[:, k - 1]
+        found, columns = np.nonzero(s <= kth[:, None])  # the k nearest and every tie of the k-th
+        order = np.lexsort((columns, s[found, columns], found))  # by row, then (s, j)
+        found, columns = found[order], columns[order]
+        rank = np.arange(len(found)) - np.searchsorted(found, found)
+        neighbours[start : start + len(block)] = columns[rank < k].reshape(len(block), k)
+    return neighbours
 
 
 def _nearest_neighbours(points, k):
-    """Each point's k neighbours by ``(s, j)``, itself left out: (N, k) int64."""
+    """Each point's k neighbours by ``(s, j)``, itself left out: (N, k) int64.
+
+    A k-d tree gives each point its k + 1 + _SPARE nearest as candidates, ranked again by the
+    contract's ``s`` and index. A row is settled when every point left out is farther, by the
+    tree's own distance with a margin for its rounding, than the k-th neighbour chosen; the few
+    others (ties at the k-th distance on a grid, many duplicates) are found by brute force.
+    """
     n = len(points)
-    neighbours = np.empty((n, k), dtype=np.int64)
-    for start in range(0, n, _BLOCK):
-        stop = min(n, start + _BLOCK)
-        s = _squared_distances(points[start:stop], points)
-        s[np.arange(stop - start), np.arange(start, stop)] = np.inf  # the point itself, not its duplicates
-        kth = np.partition(s, k - 1, axis=1)[:, k - 1]
-        rows, columns = np.nonzero(s <= kth[:, None])  # the k nearest and every tie of the k-th
-        order = np.lexsort((columns, s[rows, columns], rows))  # by row, then (s, j)
-        rows, columns = rows[order], columns[order]
-        rank = np.arange(len(rows)) - np.searchsorted(rows, rows)
-        neighbours[start:stop] = columns[rank < k].reshape(stop - start, k)
+    m = min(n, k + 1 + _SPARE)
+    reach, candidates = cKDTree(points).query(points, m)
+    candidates = candidates.reshape(n, m)
+    s = np.zeros((n, m))
+    for j in range(points.shape[1]):  # the contract's s: summed column by column
+        s += np.square(points[candidates, j] - points[:, j, None])
+    s[candidates == np.arange(n)[:, None]] = np.inf  # the point itself, not its duplicates
+    order = np.lexsort((candidates, s), axis=-1)[:, :k]
+    neighbours = np.take_along_axis(candidates, order, axis=1)
+    kth = np.take_along_axis(s, order[:, -1:], axis=1)[:, 0]
+    farthest = np.square(np.asarray(reach).reshape(n, m)[:, -1])
+    unsettled = np.flatnonzero(~(farthest > kth * (1 + 1e-9) + 1e-300)) if m < n else np.array([], dtype=np.int64)
+    if len(unsettled):
+        neighbours[unsettled] = _brute_neighbours(points, unsettled, k)
     return neighbours
 
 
