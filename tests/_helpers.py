@@ -185,3 +185,18 @@ def public_tests(summary):
 def hidden_tests(summary):
     """The tests shown after publication only; their feedback is in the grader's words."""
     return [t for t in summary["tests"] if t["visibility"] != "visible"]
+
+
+def staged_root(package):
+    """The root of ``package`` staged as the grader stages a submission, removed when this test
+    process exits: a ``Worker`` stops its processes but leaves the staging to its owner (the
+    grader's ``Implementation`` removes its own), so tests that make workers would otherwise
+    leave copies in the temporary folder."""
+    import atexit
+    import shutil
+
+    from grading.staging import stage
+
+    root = stage(package).root
+    atexit.register(shutil.rmtree, root, True)
+    return root

@@ -17,11 +17,11 @@ import textwrap
 
 import numpy as np
 import pytest
+from _helpers import staged_root
 
 from grading import REPO_ROOT, config
 from grading.errors import SandboxError
 from grading.sandbox import UID, Isolation, Worker, isolation, reserve_uid
-from grading.staging import stage
 
 CHILDREN = textwrap.dedent(
     """
@@ -143,7 +143,7 @@ def make_worker(tmp_path):
             package.mkdir(parents=True)
             (package / "__init__.py").write_text("")
             (package / "children.py").write_text(CHILDREN)
-        worker = Worker(stage(package).root, timeout=timeout)
+        worker = Worker(staged_root(package), timeout=timeout)
         workers.append(worker)
         return worker
 
@@ -457,7 +457,7 @@ def hoarding_worker(tmp_path, level):
     (package / "__init__.py").write_text("")
     (package / "hoarders.py").write_text(HOARDERS)
     isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
-    return Worker(stage(package).root, timeout=10, level=isolated)
+    return Worker(staged_root(package), timeout=10, level=isolated)
 
 
 LEVELS = [

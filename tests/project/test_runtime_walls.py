@@ -21,14 +21,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _helpers import run_grader
+from _helpers import run_grader, staged_root
 
 from grading import REPO_ROOT
 from grading.errors import ForbiddenAPI, SandboxError
 from grading.implementation import _call_on_copies
 from grading.sandbox import UID, Isolation, Worker, reserve_uid
 from grading.sandbox.walls import bar_forbidden_packages
-from grading.staging import stage
 
 LEVELS = [
     pytest.param("strongest", id="strongest"),
@@ -136,7 +135,7 @@ def worker(tmp_path, level, timeout=20):
     if level in ("uid", "uid-open"):  # uid-open: a kernel without Landlock, where the ACLs and mappings are the walls
         files_open = "Landlock off for the test" if level == "uid-open" else ""
         isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test", files_open=files_open)
-    return Worker(stage(package).root, timeout=timeout, level=isolated)
+    return Worker(staged_root(package), timeout=timeout, level=isolated)
 
 
 POINTS = np.random.default_rng(3).random((40, 3))
@@ -261,7 +260,7 @@ def test_a_library_used_in_a_child_that_exits_before_the_call_returns_is_out_of_
     (package / "__init__.py").write_text("")
     (package / "nn.py").write_text(FORKED)
     isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
-    impl = Worker(stage(package).root, timeout=20, level=isolated)
+    impl = Worker(staged_root(package), timeout=20, level=isolated)
     try:
         # (As a dedicated uid the seccomp filter refuses the fork itself: PermissionError.)
         with pytest.raises((ForbiddenAPI, ImportError, AttributeError, EOFError, SandboxError, PermissionError)):
@@ -391,7 +390,7 @@ def test_an_in_place_change_is_a_change_of_bits(tmp_path, level):
     (package / "__init__.py").write_text("")
     (package / "pca.py").write_text(SIGNED_ZEROS)
     isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
-    impl = Worker(stage(package).root, timeout=20, level=isolated)
+    impl = Worker(staged_root(package), timeout=20, level=isolated)
     try:
         impl.call("pca", "signed_zeros", (points,), {})
         assert impl.last_modified == [["args", 0]]
@@ -450,7 +449,7 @@ def test_as_a_dedicated_uid_nothing_is_left_for_the_next_submission_or_watched(t
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
     (package / "pca.py").write_text(LINGERING)
-    impl = Worker(stage(package).root, timeout=20, level=Isolation(UID, reserve_uid(), "test"))
+    impl = Worker(staged_root(package), timeout=20, level=Isolation(UID, reserve_uid(), "test"))
     try:
         refused, found = impl.call("pca", "reach", (), {})
     finally:
@@ -504,7 +503,7 @@ def test_the_rules_uid_finds_nothing_the_slots_other_uid_left(tmp_path):
     # Without Landlock (a kernel that lacks it), where /tmp is writable: under it nothing outside
     # the worker's own home is (test_as_a_dedicated_uid_nothing_is_left_for_the_next_submission...).
     isolated = Isolation(UID, reserve_uid(), "test", files_open="Landlock off for the test")
-    impl = Worker(stage(package).root, timeout=20, level=isolated)
+    impl = Worker(staged_root(package), timeout=20, level=isolated)
     name = f"/tmp/left-by-pca-{os.getpid()}"
     try:
         assert impl.call("pca", "leave", (name,), {}) == 1

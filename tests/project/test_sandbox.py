@@ -10,12 +10,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from _helpers import SUBPROCESS_BACKSTOP, reference_source, run_grader, write_reference_modules
+from _helpers import SUBPROCESS_BACKSTOP, reference_source, run_grader, staged_root, write_reference_modules
 
 from grading import REPO_ROOT
 from grading.errors import SandboxError
 from grading.sandbox import Worker, isolation
-from grading.staging import stage
 
 
 def namespace_available():
@@ -108,7 +107,7 @@ def worker(tmp_path):
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
     (package / "evil.py").write_text(EVIL)
-    w = Worker(stage(package).root, timeout=10)
+    w = Worker(staged_root(package), timeout=10)
     yield w
     w.stop()
 
@@ -304,7 +303,7 @@ def test_without_namespaces_the_dedicated_uid_reads_nothing_of_the_grader(tmp_pa
     (package / "evil.py").write_text(
         "import os\ndef read(path):\n    return open(path).read()\ndef whoami():\n    return os.getuid()\n"
     )
-    worker = Worker(stage(package).root, timeout=20, level=Isolation(UID, uid, "test"))
+    worker = Worker(staged_root(package), timeout=20, level=Isolation(UID, uid, "test"))
     try:
         assert worker.call("evil", "whoami", (), {}) == uid
         with pytest.raises(PermissionError):
@@ -360,7 +359,7 @@ def test_a_process_that_makes_itself_non_dumpable_is_still_seen_and_killed(tmp_p
             """
         )
     )
-    worker = Worker(stage(package).root, timeout=20, level=Isolation(UID, uid, "test"))
+    worker = Worker(staged_root(package), timeout=20, level=Isolation(UID, uid, "test"))
     try:
         with pytest.raises(SandboxError, match="left processes or threads running"):
             worker.call("evil", "hide", (), {})

@@ -21,12 +21,11 @@ import time
 
 import numpy as np
 import pytest
-from _helpers import SUBPROCESS_BACKSTOP, load_results, reference_package, run_grader
+from _helpers import SUBPROCESS_BACKSTOP, load_results, reference_package, run_grader, staged_root
 
 from grading import GRADED_FUNCTIONS, REPO_ROOT, config
 from grading.errors import SandboxError
 from grading.sandbox import UID, Isolation, Worker, isolation, reserve_uid
-from grading.staging import stage
 
 needs_bubblewrap = pytest.mark.skipif(isolation().level != "bubblewrap", reason="needs bubblewrap")
 
@@ -48,7 +47,7 @@ def hostile_worker(tmp_path, source, timeout=10, level="strongest"):
     isolated = None
     if level == "uid":
         isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test")
-    return Worker(stage(package).root, timeout=timeout, level=isolated)
+    return Worker(staged_root(package), timeout=timeout, level=isolated)
 
 
 # -- frozen inputs ---------------------------------------------------------------------------------
