@@ -124,18 +124,23 @@ def visible(folders):
 '''
 
 
-def worker(tmp_path, level, timeout=20):
+def worker_of(tmp_path, level, modules, timeout=20):
+    """A worker on a package of ``modules`` (name -> source) at ``level``: "strongest", "uid", or
+    "uid-open" (a dedicated uid on a kernel without Landlock)."""
     package = tmp_path / "clone" / "pcl_course"
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
-    (package / "nn.py").write_text(textwrap.dedent(NN))
-    (package / "pca.py").write_text(textwrap.dedent(PCA))
-    (package / "cluster.py").write_text(textwrap.dedent(CLUSTER))
+    for name, source in modules.items():
+        (package / f"{name}.py").write_text(textwrap.dedent(source))
     isolated = None
     if level in ("uid", "uid-open"):  # uid-open: a kernel without Landlock, where the ACLs and mappings are the walls
         files_open = "Landlock off for the test" if level == "uid-open" else ""
         isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test", files_open=files_open)
     return Worker(staged_root(package), timeout=timeout, level=isolated)
+
+
+def worker(tmp_path, level, timeout=20):
+    return worker_of(tmp_path, level, {"nn": NN, "pca": PCA, "cluster": CLUSTER}, timeout)
 
 
 POINTS = np.random.default_rng(3).random((40, 3))
@@ -255,12 +260,7 @@ def test_a_library_used_in_a_child_that_exits_before_the_call_returns_is_out_of_
     ACLs bar from those packages: a child cannot load them either (bubblewrap masks them)."""
     if level == "uid":
         assert bar_forbidden_packages() is None
-    package = tmp_path / "clone" / "pcl_course"
-    package.mkdir(parents=True)
-    (package / "__init__.py").write_text("")
-    (package / "nn.py").write_text(FORKED)
-    isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
-    impl = Worker(staged_root(package), timeout=20, level=isolated)
+    impl = worker_of(tmp_path, level, {"nn": FORKED})
     try:
         # (As a dedicated uid the seccomp filter refuses the fork itself: PermissionError.)
         with pytest.raises((ForbiddenAPI, ImportError, AttributeError, EOFError, SandboxError, PermissionError)):
@@ -385,12 +385,7 @@ def test_an_in_place_change_is_a_change_of_bits(tmp_path, level):
         assert _call_on_copies(namespace["signed_zeros"], (points,), {})[1] == [["args", 0]]
         assert _call_on_copies(namespace["same_values"], (points,), {})[1] == []
         return
-    package = tmp_path / "clone" / "pcl_course"
-    package.mkdir(parents=True)
-    (package / "__init__.py").write_text("")
-    (package / "pca.py").write_text(SIGNED_ZEROS)
-    isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
-    impl = Worker(staged_root(package), timeout=20, level=isolated)
+    impl = worker_of(tmp_path, level, {"pca": SIGNED_ZEROS})
     try:
         impl.call("pca", "signed_zeros", (points,), {})
         assert impl.last_modified == [["args", 0]]
@@ -445,11 +440,7 @@ def test_as_a_dedicated_uid_nothing_is_left_for_the_next_submission_or_watched(t
     """Helper h58's review of the uid mode: a key in the uid's keyring outlived the submission and
     the next one read it; inotify reported other users' file activity; a datagram socket pair sent
     to a path outside; /dev/shm is shared by the slots graded at once; mountinfo describes the host."""
-    package = tmp_path / "clone" / "pcl_course"
-    package.mkdir(parents=True)
-    (package / "__init__.py").write_text("")
-    (package / "pca.py").write_text(LINGERING)
-    impl = Worker(staged_root(package), timeout=20, level=Isolation(UID, reserve_uid(), "test"))
+    impl = worker_of(tmp_path, "uid", {"pca": LINGERING})
     try:
         refused, found = impl.call("pca", "reach", (), {})
     finally:
