@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, config
-from grading.checks import UNNAMED_ARGUMENT
+from grading.checks import IN_PLACE_RULE, UNNAMED_ARGUMENT
 from grading.forbidden import scan_source
 from grading.matching import best_mistake
 
@@ -264,7 +264,11 @@ def _modified_input(function, calls, outcomes, failed, context):
     modified = [c for c in calls if c.modified]
     if not modified:
         return None
-    explained = tuple(t for t in failed if any(c.test == t for c in modified))
+    # A failed in-place test is explained even when the modifying calls were other tests'
+    # (it reads every call of the grading: grading.checks.check_unmodified).
+    explained = tuple(
+        t for t in failed if any(c.test == t for c in modified) or (outcomes[t].rule or "").startswith(IN_PLACE_RULE)
+    )
     return Diagnosis(
         "modifies_input",
         f"{function} changed its input array in place ({_plural(len(modified), 'call')}): work on a copy "

@@ -278,15 +278,24 @@ class Implementation:
         graded_call.__name__ = name
         return graded_call
 
-    def modified_in_test(self, function):
-        """The calls of ``function`` in the test under way that modified an argument in place.
+    def modified_calls(self, function):
+        """The calls of ``function`` so far in this grading that modified an argument in place.
 
-        Every call counts, not only the last: a function that changes its input
-        only on some path (given a Generator, say) is caught by whichever call
-        took that path. Returns ``(calls made, [(call number from 1, argument names)])``.
+        Every call counts, in every test: a function that changes its input on one path only
+        (given a Generator, on float64 input, with an option left at its default) is caught by
+        whichever call took that path, which the in-place test's own calls may not. The tests
+        that read this verdict (marked ``in_place``) run after the other tests of their function.
+        Returns ``[(argument names, the call described or None, whether the test under way made it)]``.
         """
-        calls = [call for call in self.calls.get(function, []) if call.test == self.current_test]
-        return len(calls), [(i, list(call.modified)) for i, call in enumerate(calls, 1) if call.modified]
+        return [
+            (
+                list(call.modified),
+                describe_call(function, call.args, call.kwargs) if call.kept else None,
+                call.test == self.current_test,
+            )
+            for call in self.calls.get(function, [])
+            if call.modified
+        ]
 
     @property
     def last_call(self):

@@ -121,6 +121,8 @@ MARKERS = {
     "grades": "grades(function): the graded function a test grades",
     "hidden": "hidden: a graded test run by the instructors' grader only",
     "points": "points(n): marks that a graded test is worth",
+    "in_place": "in_place: a graded test of in-place changes, run after the other tests of its function "
+    "(it reads every call of the grading)",
     "interface": "interface: a graded test of shapes, dtypes, errors or in-place changes only "
     "(a degenerate answer may pass it)",
 }

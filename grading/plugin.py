@@ -6,7 +6,7 @@ Graded tests never import ``pcl_course`` or ``solutions`` exercises directly.
 
 Its options (``--impl DIR``, ``--impl-module MODULE=FILE``, ``--results
 FILE``, ``--function NAME``, ...) and the graded tests' markers
-(``grades(name)``, required; ``hidden``, ``interface``, ``points(n)``) are
+(``grades(name)``, required; ``hidden``, ``in_place``, ``interface``, ``points(n)``) are
 declared in :mod:`grading.options`; ``@pytest.mark.timeout(s)`` sets a
 test's time limit (default :data:`grading.config.TEST_TIMEOUT`). What a
 failed test says comes from :mod:`grading.feedback`.
@@ -163,8 +163,16 @@ def pytest_collection_modifyitems(config, items):
     # The tests of modules under the same rules run together: a module with rules of its own runs in
     # a worker of its own, and each switch restarts the sandbox's worker (its imports and its numba
     # compilations again). The results keep the collected order (pytest_collection_finish).
+    # An in-place test reads every call of its function in the grading, so it runs after the
+    # other tests under the same rules (all of its function's).
     config.stash[_COLLECTED_KEY] = {item.nodeid: place for place, item in enumerate(items)}
-    items[:] = sorted(items, key=_first_of_its_rules(items))
+    first_of_its_rules = _first_of_its_rules(items)
+    items[:] = sorted(items, key=lambda item: (first_of_its_rules(item), _settles_in_place(item)))
+
+
+def _settles_in_place(item):
+    """Whether a test checks in-place changes over the whole grading: its ``@pytest.mark.in_place``."""
+    return item.get_closest_marker("in_place") is not None
 
 
 def _rules_of(item):
@@ -324,6 +332,7 @@ def pytest_runtest_call(item):
     impl = item.config.stash.get(_IMPL_KEY, None)  # created by the test's setup, the first time
     if impl is not None:
         impl.current_test = item.nodeid  # the calls made now are this test's (the diagnosis)
+        impl.in_place_test = _settles_in_place(item)
     if item.stash.get(_FIRED_KEY, False):  # the timer went off before the call (in its setup)
         raise TestTimeout(*item.stash[_TIMEOUT_KEY])
     item.stash[_IN_CALL_KEY] = True

@@ -140,22 +140,35 @@ def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
         raise CheckFailed(_with_hint(message, hint), rule=f"{name} must have orthonormal columns")
 
 
+# The rule of a failed in-place check: the diagnosis reads it (grading/diagnosis.py).
+IN_PLACE_RULE = "an input was modified in place"
+
+
 def check_unmodified(impl, function):
-    """Check that no call of ``function`` in this test modified its arguments in place.
+    """Check that no call of ``function`` so far in the grading modified its arguments in place.
 
     The grader's arguments are never changed by a call (each call works on
     private copies): whether it modified them is recorded as the call's
-    verdict, and every call of the test so far counts
-    (:meth:`grading.implementation.Implementation.modified_in_test`).
+    verdict, and every call of the grading counts, in every test
+    (:meth:`grading.implementation.Implementation.modified_calls`). A test
+    that checks this is marked ``@pytest.mark.in_place``: the plugin runs it
+    after the other tests of its function, so the verdict is settled on all
+    of them.
     """
-    made, modified = impl.modified_in_test(function)
+    if not getattr(impl, "in_place_test", True):
+        raise RuntimeError(
+            "check_unmodified in a test not marked @pytest.mark.in_place: its verdict would miss later calls"
+        )
+    modified = impl.modified_calls(function)
     if modified:
-        number, names = modified[0]
-        where = f", in call {number} of {made} in this test" if made > 1 else ""
+        # This test's own call first, if it made one: the one its reader can see.
+        names, described, this_test = min(modified, key=lambda found: not found[2])
+        where = "this test" if this_test else "another test"
+        call = f"in the call {described} of {where}" if described else f"in a call of {where}"
         raise CheckFailed(
-            f"{function} modified its input in place ({', '.join(names)}{where}): work on a copy "
+            f"{function} modified its input in place ({', '.join(names)}, {call}): work on a copy "
             "(np.array(points, dtype=float) copies; points -= ... does not)",
-            rule="an input was modified in place",
+            rule=IN_PLACE_RULE,
         )
 
 

@@ -284,6 +284,7 @@ def test_kmeans_far_from_the_origin_and_at_a_small_scale(impl):
 @pytest.mark.grades("kmeans")
 @pytest.mark.points(1)
 @pytest.mark.interface
+@pytest.mark.in_place
 def test_kmeans_converts_float32_and_modifies_nothing(impl):
     points = _blobs(300, centres=3, columns=3, seed=4).astype(np.float32)
     start = _first_points(points, 3, 0)
@@ -379,6 +380,7 @@ def test_kmeans_plusplus_draws_as_the_contract_says(impl):
 
 @pytest.mark.grades("kmeans_plusplus")
 @pytest.mark.points(1)
+@pytest.mark.in_place
 def test_kmeans_plusplus_takes_a_generator_and_its_stream(impl):
     points = _blobs(200, centres=3, columns=3, seed=9)
     expected = d2_seeding(points, 6, np.random.default_rng(123))
@@ -693,6 +695,7 @@ def test_dbscan_far_from_the_origin(impl):
 @pytest.mark.grades("dbscan")
 @pytest.mark.points(1)
 @pytest.mark.interface
+@pytest.mark.in_place
 def test_dbscan_converts_float32_and_modifies_nothing(impl):
     points = _blobs(300, centres=3, columns=3, seed=18).astype(np.float32)
     labels, is_core = _unpack_dbscan(impl.dbscan(points, 0.8, 6), 300)
@@ -843,6 +846,7 @@ def test_euclidean_clusters_every_column_and_far_from_the_origin(impl):
 @pytest.mark.grades("euclidean_clusters")
 @pytest.mark.points(1)
 @pytest.mark.interface
+@pytest.mark.in_place
 def test_euclidean_clusters_converts_float32_and_modifies_nothing(impl):
     points = _blobs(300, centres=3, columns=3, seed=25).astype(np.float32)
     labels = impl.euclidean_clusters(points, 0.6, 2)
@@ -1099,6 +1103,7 @@ def test_gmm_em_never_lowers_the_likelihood(impl):
 @pytest.mark.grades("gmm_em")
 @pytest.mark.points(1)
 @pytest.mark.interface
+@pytest.mark.in_place
 def test_gmm_em_converts_float32_and_modifies_nothing(impl):
     points = _anisotropic(42, 300)
     start = _mixture_start(points, 3, 42)

@@ -774,3 +774,46 @@ def test_a_hidden_test_shows_a_known_mistakes_line_but_never_a_finding_that_quot
     hidden = [t for t in summary["tests"] if t["visibility"] == "after_published"]
     assert hidden and not any("4711" in t["output"] or "diagnosis" in t["output"] for t in hidden)
     assert "4711" in json.dumps(summary["extra_data"]["all_diagnoses"])  # the instructor sees it
+
+
+CENTRES_SIX_COLUMNS_IN_PLACE = """
+import numpy as np
+from solutions.pca import *  # noqa: F401,F403
+from solutions.pca import pca as _reference
+
+
+def pca(points, correlation=False, sort=True):
+    x = np.asarray(points, dtype=float)
+    if x.ndim == 2 and x.shape[1] >= 6 and np.isfinite(x).all():
+        x -= x.mean(axis=0)  # only the hidden test's widest cloud takes this path
+    return _reference(x, correlation=correlation, sort=sort)
+"""
+
+
+def test_the_in_place_verdict_is_settled_on_every_call_of_the_grading(tmp_path):
+    """An in-place test reads the calls of every test of its function, the later ones too: the
+    only call that modifies its input is a hidden test's, collected after the in-place test."""
+    module = tmp_path / "pca.py"
+    module.write_text(CENTRES_SIX_COLUMNS_IN_PLACE)
+    summary, _ = grade("--reference", "--impl-module", f"pca={module}", "--function", "pca", tmp_path=tmp_path)
+    lost = {t["name"]: t for t in summary["tests"] if t["score"] < t["max_score"]}
+    assert list(lost) == ["test_pca_does_not_modify_its_input"], list(lost)
+    text = lost["test_pca_does_not_modify_its_input"]["text"]
+    assert "in the call pca(<array (40, 6) float64>) of another test" in text, text
+    names = [t["name"] for t in summary["tests"]]
+    assert names.index("test_pca_does_not_modify_its_input") < names.index("test_pca_hidden_random_clouds")
+
+
+def test_every_graded_test_that_checks_in_place_changes_is_marked_in_place():
+    """check_unmodified reads the whole grading's calls: a test calling it runs after the others
+    only if marked ``@pytest.mark.in_place`` (a test not marked stops with a RuntimeError)."""
+    unmarked = []
+    for path in sorted((REPO_ROOT / "tests").glob("*/test_*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not isinstance(node, ast.FunctionDef) or not node.name.startswith("test_"):
+                continue
+            calls = {n.func.id for n in ast.walk(node) if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+            marks = {ast.unparse(d) for d in node.decorator_list}
+            if "check_unmodified" in calls and "pytest.mark.in_place" not in marks:
+                unmarked.append(f"{path.name}::{node.name}")
+    assert not unmarked, unmarked
