@@ -39,11 +39,10 @@ import os
 import platform
 import shutil
 import sys
-import tempfile
 from importlib import metadata
 from pathlib import Path
 
-from grading import ASSIGNMENTS, REPO_ROOT, instructors_grader
+from grading import ASSIGNMENTS, REPO_ROOT, instructors_grader, scratch
 from grading.errors import UsageError, existing_folder
 from grading.options import SHARED
 from grading.results import Grading
@@ -64,13 +63,22 @@ def find_package(submission):
 
 
 def grade(args):
+    if args.results:
+        return _grade(args, Path(args.results))
+    folder = scratch.folder("grading-results-")  # the table is the output
+    try:
+        return _grade(args, Path(folder) / "results.json")
+    finally:
+        scratch.remove(folder)
+
+
+def _grade(args, results):
     if args.reference:
         impl_dir = REPO_ROOT / "solutions"
     elif args.submission:
         impl_dir = find_package(args.submission)
     else:
         raise UsageError("give a SUBMISSION folder or --reference")
-    results = Path(args.results) if args.results else Path(tempfile.mkdtemp()) / "results.json"
     # The reference and the project's own wrong submissions are trusted code;
     # a student's submission runs in the sandbox.
     sandbox = not args.reference and not args.impl_module

@@ -7,13 +7,11 @@ Used by ``python -m grading grade`` (:mod:`grading.cli`), ``batch``
 
 import json
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
 import threading
 
-from grading import GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT
+from grading import GRADED_TESTS, HIDDEN_TESTS, REPO_ROOT, scratch
 from grading.config import GRADER_ENVIRONMENT
 from grading.options import pytest_arguments
 from grading.results import clean
@@ -66,7 +64,8 @@ def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None,
     # Only the plugins named above: the environment's others (nbval, dash,
     # pytest-benchmark, xdist) have no say in a grade, and importing them costs 0.2 s a grade.
     env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1", PYTEST_DISABLE_PLUGIN_AUTOLOAD="1", **GRADER_ENVIRONMENT)
-    folder = tempfile.mkdtemp(prefix="grading-options-")  # mode 0700: the grader's user only
+    scratch.sweep()  # what killed gradings left on this machine (grading/scratch.py)
+    folder = scratch.folder("grading-options-")  # mode 0700: the grader's user only
     options_file = os.path.join(folder, "options.json")
     reader = writer = None
     if progress is not None:
@@ -95,7 +94,7 @@ def run_graded_tests(impl_dir, results, *, keyword=None, junit=None, tests=None,
             # run gives the submission the grader's own user): progress is a courtesy, never a wait.
             listener.join(timeout=PROGRESS_DRAIN)
     finally:
-        shutil.rmtree(folder, ignore_errors=True)
+        scratch.remove(folder)
     return process.returncode, output
 
 

@@ -13,11 +13,10 @@ grade is never given to a tree the grader had to mutilate.
 
 import os
 import stat
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grading import config
+from grading import config, scratch
 from grading.errors import StagingError
 
 
@@ -173,7 +172,7 @@ def stage(package_dir, into=None):
         With one line naming the first entry that cannot be staged.
     """
     package_dir = Path(package_dir)
-    root = Path(into) if into is not None else Path(tempfile.mkdtemp(prefix="grading-staged-"))
+    root = Path(into) if into is not None else Path(scratch.folder("grading-staged-"))
     root.mkdir(parents=True, exist_ok=True)
     root.chmod(0o700)  # the worker opens it to its own uid only (grading/sandbox/)
     parent_fd = _open_directory(str(package_dir.parent), None, "the submission's folder")

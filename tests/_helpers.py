@@ -193,10 +193,10 @@ def staged_root(package):
     grader's ``Implementation`` removes its own), so tests that make workers would otherwise
     leave copies in the temporary folder."""
     import atexit
-    import shutil
 
+    from grading import scratch
     from grading.staging import stage
 
     root = stage(package).root
-    atexit.register(shutil.rmtree, root, True)
+    atexit.register(scratch.remove, root)
     return root

@@ -32,7 +32,7 @@ import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, EXERCISE_MODULES, REPO_ROOT
+from grading import ASSIGNMENT_MODULES, ASSIGNMENTS, EXERCISE_MODULES, REPO_ROOT, scratch
 from grading.config import MAX_TEXT
 from grading.errors import NothingToGrade, StagingError
 from grading.instructors.leakcheck import find_leaks
@@ -365,7 +365,7 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
         _write_json(results, _failure_results(message, started))
         print(message)
         return 1
-    work = Path(tempfile.mkdtemp(prefix="gradescope-submission-"))
+    work = Path(scratch.folder("gradescope-submission-"))
     try:
         try:
             package, note = assemble(root / "submission", work, assignment)
@@ -393,4 +393,4 @@ def autograde(root="/autograder", budget=None, assignment="lecture1"):
             return 1
         return 0
     finally:
-        shutil.rmtree(work, ignore_errors=True)
+        scratch.remove(work)

@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from grading import config
+from grading import config, scratch
 from grading.errors import ForbiddenAPI, SandboxError
 from grading.sandbox import mappings, protocol
 from grading.sandbox.bubblewrap import (
@@ -122,7 +122,7 @@ class Worker:
             # from), by no other sandbox uid: a classmate's is out of reach.
             os.chown(self.staged_root, 0, self.uid)
             os.chmod(self.staged_root, 0o750)
-        self.work = tempfile.mkdtemp(prefix="grading-home-")  # HOME of the uid and none levels
+        self.work = scratch.folder("grading-home-")  # HOME of the uid and none levels
         if self.uid is not None:
             os.chown(self.work, self.uid, self.uid)
         self.exchange = os.memfd_create("pcl-call-arguments")
@@ -166,7 +166,7 @@ class Worker:
                     break
                 time.sleep(0.01)
         if self.work:
-            shutil.rmtree(self.work, ignore_errors=True)
+            scratch.remove(self.work)
             self.work = None
         if self.exchange is not None:
             os.close(self.exchange)
