@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from grading import GRADED_FUNCTIONS, config
-from grading.checks import IN_PLACE_RULE, UNNAMED_ARGUMENT
+from grading.checks import IN_PLACE_RULE, NO_ANSWER_RULE, UNNAMED_ARGUMENT
 from grading.forbidden import scan_source
 from grading.matching import best_mistake
 
@@ -63,6 +63,7 @@ class Call:
     where: str = None  # file:line in the submission, when known
     modified: tuple = ()  # the contract's names of the arguments it changed in place
     kept: bool = True  # False: the arguments were too large to keep
+    sandbox: tuple = None  # (message, kind) of a SandboxError it raised
 
     @property
     def raised(self):
@@ -197,7 +198,8 @@ def _same_error_everywhere(function, calls, outcomes, failed, context):
     if error_type == "NameError" and shown:
         name = shown.split("'")[1] if shown.count("'") >= 2 else ""
         message += _import_hint(name, GRADED_FUNCTIONS[function])
-    explained = tuple(t for t in failed if any(c.test == t for c in calls))
+    # The in-place test makes no call: it failed because no call answered, for this same cause.
+    explained = tuple(t for t in failed if any(c.test == t for c in calls) or outcomes[t].rule == NO_ANSWER_RULE)
     return Diagnosis("same_error_everywhere", message, explained)
 
 

@@ -9,16 +9,15 @@ this repository stay what the tests use.
 import importlib.util
 import itertools
 import os
-import shutil
 import sys
 import traceback
 from pathlib import Path
 
 import numpy as np
 
-from grading import GRADED_FUNCTIONS, REPO_ROOT, config
+from grading import GRADED_FUNCTIONS, REPO_ROOT, config, scratch
 from grading.diagnosis import Call, contract_signature
-from grading.errors import ForbiddenAPI, NotImplementedYet, StagingError, StudentError  # noqa: F401
+from grading.errors import ForbiddenAPI, NotImplementedYet, SandboxError, StagingError, StudentError  # noqa: F401
 from grading.forbidden import read_source, scan_package
 from grading.recording import Recorder
 
@@ -161,7 +160,10 @@ class Implementation:
         self._last_call, self._last_call_text = None, None
         self.last_modified = []  # names of the arguments the last call modified in place
         self.sandboxed = sandbox
-        self.current_test = None  # set by the plugin: the test under way
+        self.current_test = None  # the test under way (start_test)
+        self.in_place_test = False  # whether it is marked in_place (grading.checks.check_unmodified)
+        self.test_grades = {}  # test -> the graded function it grades
+        self.passed_answers = set()  # the tests passed that check answers (not marked interface)
         self.calls = {}  # graded function -> [Call], for the diagnosis
         self.recorder = Recorder()  # what the calls keep, within one budget for the whole grading
         self.worker = None
@@ -256,6 +258,8 @@ class Implementation:
             except Exception as exc:
                 call.error_type = type(exc).__name__
                 call.error = _first_line(exc)
+                if isinstance(exc, SandboxError):
+                    call.sandbox = (str(exc), exc.kind)  # the grader's own words, the kind for a hidden test
                 where, own = _origin(exc, self)
                 call.where = _first_line(getattr(exc, "where", None) or where)  # a file name the submission chose
                 if not hasattr(exc, "raised_by_submission"):
@@ -297,6 +301,44 @@ class Implementation:
             if call.modified
         ]
 
+    def start_test(self, test, function, in_place=False):
+        """Called by the plugin as each test's call begins: the calls made now are this test's,
+        which grades ``function``; the last call reported in feedback is one of this test's."""
+        self.current_test, self.in_place_test = test, in_place
+        self.test_grades[test] = function
+        self._last_call, self._last_call_text = None, None
+
+    def finish_test(self, test, passed, interface):
+        """Called by the plugin as each test's call ends: whether it passed, and whether it checks
+        answers or only the interface (shapes, errors, in-place changes)."""
+        if passed and not interface:
+            self.passed_answers.add(test)
+
+    def passed_a_test_of_answers(self, function):
+        """Whether a test of ``function``'s answers (not marked interface) has passed so far."""
+        return any(self.test_grades.get(test) == function for test in self.passed_answers)
+
+    def call_counts(self, function):
+        """``(made, returned)``: the calls of ``function`` so far in this grading and those that
+        returned an answer."""
+        calls = self.calls.get(function, [])
+        return len(calls), sum(not call.raised for call in calls)
+
+    def sandbox_failure_of(self, function):
+        """``(message, kind)`` when every call of ``function`` so far failed in the sandbox alike
+        (its module cannot be imported, say), else None."""
+        failures = {call.sandbox for call in self.calls.get(function, [])}
+        return failures.pop() if len(failures) == 1 and None not in failures else None
+
+    def not_implemented_in_tests_of(self, function):
+        """The graded function whose stub stopped a test of ``function`` (a call that raised
+        NotImplementedError in one of its tests: its own, or one it needs first), or None."""
+        tests = {test for test, graded in self.test_grades.items() if graded == function}
+        for name, calls in self.calls.items():
+            if any(call.test in tests and call.error_type == "NotImplementedError" for call in calls):
+                return name
+        return None
+
     @property
     def last_call(self):
         """The last call, described for feedback (``pca(<array (100, 3) float64>)``), or None.
@@ -325,4 +367,4 @@ class Implementation:
         if self.worker is not None:
             self.worker.close()
         if self.staged is not None:
-            shutil.rmtree(self.staged.root, ignore_errors=True)
+            scratch.remove(self.staged.root)

@@ -331,8 +331,7 @@ def _over_budget(config):
 def pytest_runtest_call(item):
     impl = item.config.stash.get(_IMPL_KEY, None)  # created by the test's setup, the first time
     if impl is not None:
-        impl.current_test = item.nodeid  # the calls made now are this test's (the diagnosis)
-        impl.in_place_test = _settles_in_place(item)
+        impl.start_test(item.nodeid, graded_function(item), in_place=_settles_in_place(item))
     if item.stash.get(_FIRED_KEY, False):  # the timer went off before the call (in its setup)
         raise TestTimeout(*item.stash[_TIMEOUT_KEY])
     item.stash[_IN_CALL_KEY] = True
@@ -409,6 +408,9 @@ def pytest_runtest_makereport(item, call):
         results[item.nodeid] = _new_result(item, f"0.{len(results) + 1}")
     result = results[item.nodeid]
     outcomes = item.config.stash.setdefault(_OUTCOMES_KEY, {})
+    impl = item.config.stash.get(_IMPL_KEY, None)
+    if report.when == "call" and impl is not None:
+        impl.finish_test(item.nodeid, report.passed, interface=item.get_closest_marker("interface") is not None)
     if report.when == "call" and report.passed:
         result.score, result.passed, result.feedback = result.max_score, True, ""
         outcomes[item.nodeid] = Outcome(True)

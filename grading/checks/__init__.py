@@ -8,7 +8,7 @@ broke without any value: what a hidden test shows.
 
 import numpy as np
 
-from grading.errors import CheckFailed, DidNotRaise
+from grading.errors import CheckFailed, DidNotRaise, NotImplementedYet, SandboxError
 
 _DTYPE_KINDS = {"float64": np.float64, "int64": np.int64, "bool": np.bool_}
 
@@ -140,11 +140,13 @@ def check_orthonormal_columns(matrix, name, atol=1e-8, hint=""):
         raise CheckFailed(_with_hint(message, hint), rule=f"{name} must have orthonormal columns")
 
 
-# The rule of a failed in-place check: the diagnosis reads it (grading/diagnosis.py).
+# The rules of a failed in-place test: the diagnosis reads them (grading/diagnosis.py).
 IN_PLACE_RULE = "an input was modified in place"
+NO_ANSWER_RULE = "no call returned an answer"
+NO_RIGHT_ANSWER_RULE = "no test of the answers passed"
 
 
-def check_unmodified(impl, function):
+def check_unmodified(impl, function, answered=False):
     """Check that no call of ``function`` so far in the grading modified its arguments in place.
 
     The grader's arguments are never changed by a call (each call works on
@@ -154,11 +156,17 @@ def check_unmodified(impl, function):
     that checks this is marked ``@pytest.mark.in_place``: the plugin runs it
     after the other tests of its function, so the verdict is settled on all
     of them.
+
+    With ``answered`` (a test that makes no call of its own), the point is
+    also earned: at least one call returned an answer, and at least one test
+    of the function's answers (one not marked ``interface``) passed. A
+    function that answers zeros, or nothing, leaves its inputs alone too.
     """
-    if not getattr(impl, "in_place_test", True):
+    if not impl.in_place_test:
         raise RuntimeError(
             "check_unmodified in a test not marked @pytest.mark.in_place: its verdict would miss later calls"
         )
+    getattr(impl, function)  # what stops every test of the function stops this one (a forbidden import)
     modified = impl.modified_calls(function)
     if modified:
         # This test's own call first, if it made one: the one its reader can see.
@@ -169,6 +177,28 @@ def check_unmodified(impl, function):
             f"{function} modified its input in place ({', '.join(names)}, {call}): work on a copy "
             "(np.array(points, dtype=float) copies; points -= ... does not)",
             rule=IN_PLACE_RULE,
+        )
+    if not answered:
+        return
+    made, returned = impl.call_counts(function)
+    if not returned:
+        stub = impl.not_implemented_in_tests_of(function)
+        if stub is not None:
+            raise NotImplementedYet(stub)
+        failure = impl.sandbox_failure_of(function)
+        if failure is not None:  # said as the function's other tests say it
+            raise SandboxError(*failure)
+        what = "was made before this test" if not made else "returned an answer"
+        raise CheckFailed(
+            f"no call of {function} {what}, so whether it leaves its inputs alone is not known: "
+            f"run this test with the function's other tests (-k test_{function}_) and fix them first",
+            rule=NO_ANSWER_RULE,
+        )
+    if not impl.passed_a_test_of_answers(function):
+        raise CheckFailed(
+            f"no test of {function}'s answers has passed: this point, which leaving the inputs alone "
+            "cannot earn by itself, is given once one does",
+            rule=NO_RIGHT_ANSWER_RULE,
         )
 
 

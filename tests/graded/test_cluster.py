@@ -15,7 +15,7 @@ import pytest
 from sklearn.cluster import KMeans
 from sklearn.datasets import make_blobs
 
-from grading.checks import CheckFailed, as_list, check_array, check_close, check_unmodified, raises
+from grading.checks import CheckFailed, as_list, check_array, check_close, raises
 from grading.checks.cluster import linked_components, lloyd, nearest_centres, scikit_learn_em
 
 # What a wrong answer far from the origin most likely means.
@@ -284,14 +284,11 @@ def test_kmeans_far_from_the_origin_and_at_a_small_scale(impl):
 @pytest.mark.grades("kmeans")
 @pytest.mark.points(1)
 @pytest.mark.interface
-@pytest.mark.in_place
-def test_kmeans_converts_float32_and_modifies_nothing(impl):
+def test_kmeans_converts_float32(impl):
     points = _blobs(300, centres=3, columns=3, seed=4).astype(np.float32)
     start = _first_points(points, 3, 0)
     labels, centers, inertia, n_iter = _unpack(impl.kmeans(points, start), 300, 3, 3)
-    check_unmodified(impl, "kmeans")
     expected = _unpack(impl.kmeans(points.astype(np.float64), start.astype(np.float64)), 300, 3, 3)
-    check_unmodified(impl, "kmeans")  # float64 centres: no conversion copies them
     _check_labels(labels, expected[0], " (float32 points are converted to float64 first)")
     check_close(centers, expected[1], "centers", rtol=CENTRES_RTOL, atol=CENTRES_ATOL)
 
@@ -380,13 +377,11 @@ def test_kmeans_plusplus_draws_as_the_contract_says(impl):
 
 @pytest.mark.grades("kmeans_plusplus")
 @pytest.mark.points(1)
-@pytest.mark.in_place
 def test_kmeans_plusplus_takes_a_generator_and_its_stream(impl):
     points = _blobs(200, centres=3, columns=3, seed=9)
     expected = d2_seeding(points, 6, np.random.default_rng(123))
     _check_draws(impl.kmeans_plusplus(points, 6, rng=np.random.default_rng(123)), expected, "a Generator")
     _check_draws(impl.kmeans_plusplus(points, 6, rng=123), expected, "the same seed as an int")
-    check_unmodified(impl, "kmeans_plusplus")
 
 
 @pytest.mark.grades("kmeans_plusplus")
@@ -695,13 +690,10 @@ def test_dbscan_far_from_the_origin(impl):
 @pytest.mark.grades("dbscan")
 @pytest.mark.points(1)
 @pytest.mark.interface
-@pytest.mark.in_place
-def test_dbscan_converts_float32_and_modifies_nothing(impl):
+def test_dbscan_converts_float32(impl):
     points = _blobs(300, centres=3, columns=3, seed=18).astype(np.float32)
     labels, is_core = _unpack_dbscan(impl.dbscan(points, 0.8, 6), 300)
-    check_unmodified(impl, "dbscan")
     _check_dbscan(impl, points.astype(np.float64), 0.8, 6, (labels, is_core), " (float32 points are converted)")
-    check_unmodified(impl, "dbscan")  # float64 points: no conversion copies them
 
 
 @pytest.mark.grades("dbscan")
@@ -846,13 +838,10 @@ def test_euclidean_clusters_every_column_and_far_from_the_origin(impl):
 @pytest.mark.grades("euclidean_clusters")
 @pytest.mark.points(1)
 @pytest.mark.interface
-@pytest.mark.in_place
-def test_euclidean_clusters_converts_float32_and_modifies_nothing(impl):
+def test_euclidean_clusters_converts_float32(impl):
     points = _blobs(300, centres=3, columns=3, seed=25).astype(np.float32)
     labels = impl.euclidean_clusters(points, 0.6, 2)
-    check_unmodified(impl, "euclidean_clusters")
     _check_components(impl, points.astype(np.float64), 0.6, 2, expected=labels, what=" (float32 is converted)")
-    check_unmodified(impl, "euclidean_clusters")  # float64 points: no conversion copies them
 
 
 @pytest.mark.grades("euclidean_clusters")
@@ -1103,14 +1092,11 @@ def test_gmm_em_never_lowers_the_likelihood(impl):
 @pytest.mark.grades("gmm_em")
 @pytest.mark.points(1)
 @pytest.mark.interface
-@pytest.mark.in_place
-def test_gmm_em_converts_float32_and_modifies_nothing(impl):
+def test_gmm_em_converts_float32(impl):
     points = _anisotropic(42, 300)
     start = _mixture_start(points, 3, 42)
     result = _unpack_em(impl.gmm_em(points.astype(np.float32), *start, 20, 0.0), 300, 3, 2)
-    check_unmodified(impl, "gmm_em")
     _check_em(impl, points.astype(np.float32).astype(np.float64), start, 20, 0.0, expected=result, what=" (float32)")
-    check_unmodified(impl, "gmm_em")
 
 
 @pytest.mark.grades("gmm_em")

@@ -12,7 +12,7 @@ import pytest
 from sklearn.datasets import make_blobs, make_circles, make_moons
 from sklearn.metrics import adjusted_rand_score
 
-from grading.checks import CheckFailed, as_list, check_array, check_close, check_unmodified, raises
+from grading.checks import CheckFailed, as_list, check_array, check_close, raises
 from grading.checks.cluster import laplacian, neighbour_graph, njw_labels, projector_distance
 
 WEIGHTS_RTOL = 1e-12  # exp(-s / (2 sigma^2)) and exp(-0.5 * s / sigma^2) differ by an ulp or two
@@ -138,13 +138,11 @@ def test_knn_graph_every_column_and_far_from_the_origin(impl):
 @pytest.mark.grades("knn_graph")
 @pytest.mark.points(1)
 @pytest.mark.interface
-@pytest.mark.in_place
-def test_knn_graph_converts_float32_rejects_bad_arguments_and_modifies_nothing(impl):
+def test_knn_graph_converts_float32_and_rejects_bad_arguments(impl):
     points = _cloud(60, seed=4)
     single = points.astype(np.float32)
     actual = _unpack_graph(impl.knn_graph(single, 5, 1.0), 60)
     impl.knn_graph(np.ascontiguousarray(points, dtype=np.float64), 5)  # no conversion copies these
-    check_unmodified(impl, "knn_graph")
     expected = neighbour_graph(single.astype(np.float64), 5, 1.0)
     if not (np.array_equal(actual[0], expected[0]) and np.array_equal(actual[1], expected[1])):
         raise CheckFailed("float32 points must be converted to float64 first", rule="the links are wrong")
@@ -286,12 +284,10 @@ def test_spectral_embedding_counts_the_components(impl):
 @pytest.mark.grades("spectral_embedding")
 @pytest.mark.points(1)
 @pytest.mark.interface
-@pytest.mark.in_place
-def test_spectral_embedding_rejects_bad_graphs_and_modifies_nothing(impl):
+def test_spectral_embedding_rejects_bad_graphs(impl):
     indptr, indices, weights = _path(6)
     impl.spectral_embedding(indptr, indices, weights.astype(np.float32), 2)
     impl.spectral_embedding(indptr, indices, np.ascontiguousarray(weights, dtype=np.float64), 2)
-    check_unmodified(impl, "spectral_embedding")
     asymmetric = weights.copy()
     asymmetric[0] = 2.0
     unsorted = indices.copy()
@@ -422,13 +418,11 @@ def test_spectral_clustering_of_touching_blobs_of_unequal_spread(impl):
 @pytest.mark.grades("spectral_clustering")
 @pytest.mark.points(1)
 @pytest.mark.interface
-@pytest.mark.in_place
-def test_spectral_clustering_rejects_bad_arguments_and_modifies_nothing(impl):
+def test_spectral_clustering_rejects_bad_arguments(impl):
     points = make_blobs(60, centers=2, random_state=13)[0]
     three_groups = np.vstack([points[:20], points[:20] + 100.0, points[:20] - 100.0])
     impl.spectral_clustering(points.astype(np.float32), 2, 5)
     impl.spectral_clustering(np.ascontiguousarray(points, dtype=np.float64), 2)  # no conversion copies these
-    check_unmodified(impl, "spectral_clustering")
     cases = [
         ({"points": points[:, 0]}, "points"),
         ({"n_clusters": 0}, "n_clusters"),

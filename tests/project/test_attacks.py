@@ -353,5 +353,5 @@ def test_an_input_modified_in_place_fails_as_it_does_locally(tmp_path):
     write_reference_modules(clone / "pcl_course", ())
     official, _ = grade(clone, tmp_path, "-k", "test_pca_")
     status = {t["name"]: t["status"] for t in local["tests"]}
-    assert status["test_pca_does_not_modify_its_input"] == "failed"
+    assert status["test_pca_does_not_modify_its_inputs"] == "failed"
     assert {t["name"]: t["status"] for t in official["tests"]} == status

@@ -797,11 +797,11 @@ def test_the_in_place_verdict_is_settled_on_every_call_of_the_grading(tmp_path):
     module.write_text(CENTRES_SIX_COLUMNS_IN_PLACE)
     summary, _ = grade("--reference", "--impl-module", f"pca={module}", "--function", "pca", tmp_path=tmp_path)
     lost = {t["name"]: t for t in summary["tests"] if t["score"] < t["max_score"]}
-    assert list(lost) == ["test_pca_does_not_modify_its_input"], list(lost)
-    text = lost["test_pca_does_not_modify_its_input"]["text"]
+    assert list(lost) == ["test_pca_does_not_modify_its_inputs"], list(lost)
+    text = lost["test_pca_does_not_modify_its_inputs"]["text"]
     assert "in the call pca(<array (40, 6) float64>) of another test" in text, text
     names = [t["name"] for t in summary["tests"]]
-    assert names.index("test_pca_does_not_modify_its_input") < names.index("test_pca_hidden_random_clouds")
+    assert names.index("test_pca_does_not_modify_its_inputs") < names.index("test_pca_hidden_random_clouds")
 
 
 def test_every_graded_test_that_checks_in_place_changes_is_marked_in_place():

@@ -452,8 +452,9 @@ def test_a_pca_that_hides_its_in_place_change_loses_the_point(tmp_path):
     package = tmp_path / "clone" / "pcl_course"
     shutil.copytree(REPO_ROOT / "pcl_course", package, ignore=shutil.ignore_patterns("__pycache__"))
     (package / "pca.py").write_text(TAMPERED_REFERENCE)
-    results, _ = run_grader(str(tmp_path / "clone"), "-k", "test_pca_does_not_modify_its_input", tmp_path=tmp_path)
-    (test,) = [t for t in results["tests"] if t["name"].startswith("test_pca_does_not_modify_its_input")]
+    # -k "test_pca_ and not kernel": the in-place test reads the calls of pca's other tests
+    results, _ = run_grader(str(tmp_path / "clone"), "-k", "test_pca_ and not kernel", tmp_path=tmp_path)
+    (test,) = [t for t in results["tests"] if t["name"].startswith("test_pca_does_not_modify_its_inputs")]
     assert test["score"] == 0 and "modified its input in place" in test["text"], test["text"]
 
 

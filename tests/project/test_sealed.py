@@ -146,7 +146,9 @@ def test_rewriting_the_inputs_never_raises_a_score(tmp_path):
     # The rewrite itself is seen: the in-place tests fail on it, and only on it.
     in_place = {t["name"]: t for t in cheat["tests"] if "does_not_modify" in t["name"]}
     assert in_place and all(t["score"] == 0 and "modified its input in place" in t["text"] for t in in_place.values())
-    assert all(t["score"] == t["max_score"] for t in honest["tests"] if t["name"] in in_place)
+    # (The honest answers are wrong too: where no test of a function's answers passes, its in-place
+    # point is not given either, for that reason and not an in-place change.)
+    assert not any("modified its input in place" in t["text"] for t in honest["tests"] if t["name"] in in_place)
     assert cheat["score"] < honest["score"] < honest["max_score"]
 
 

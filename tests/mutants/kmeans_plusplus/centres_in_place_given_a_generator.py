@@ -1,6 +1,6 @@
 """Centres the caller's points in place, on one path only: given a Generator (np.asarray makes no
-copy of a float64 array). The indices drawn are right; the in-place check must look at every call
-of a test, not the last one (given the same seed as an int, the points stay as they were)."""
+copy of a float64 array). The indices drawn are right; the in-place check must look at every call,
+not the last one (given the same seed as an int, the points stay as they were)."""
 
 import numpy as np
 
