@@ -34,12 +34,12 @@ from grading.sandbox.walls import (
     bar_sandbox_uids,
     isolation,
     make_reachable,
-    network_wall,
     permission_wall,
     protect,
     protected_paths,
     remove_files_of,
     reserve_uid,
+    worker_walls,
 )
 
 __all__ = [
@@ -59,7 +59,6 @@ __all__ = [
     "living_processes",
     "make_reachable",
     "masked_paths",
-    "network_wall",
     "permission_wall",
     "process_limit",
     "protect",
@@ -69,4 +68,5 @@ __all__ = [
     "set_generator_state",
     "site_packages",
     "tasks_of_user",
+    "worker_walls",
 ]

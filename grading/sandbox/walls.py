@@ -15,7 +15,7 @@
     platform's, such as Gradescope's ``/autograder`` with its record of
     earlier results; ``batch``'s class folder and reports: :func:`protect`)
     cannot be read (:func:`permission_wall`),
-    and that a seccomp filter closes the network (:func:`network_wall`; the
+    and that a seccomp filter closes the network (:func:`worker_walls`; the
     worker refuses to run without it). Where the kernel has Landlock (and the
     container lets it be used), the same probe measures that the worker can
     confine its files to the interpreter, the environment, the system's
@@ -389,7 +389,7 @@ def permission_wall(uid, protected):
     return None
 
 
-def network_wall(uid):
+def worker_walls(uid):
     """Whether a worker running as ``uid`` can close its network (seccomp) and confine its files
     (Landlock): ``(None or why not, None or why not)``.
 
@@ -481,7 +481,7 @@ def isolation(uid=None):
             )
     if wall is not None:
         return Isolation(NONE, None, f"{why_not}; {wall}")
-    network, files = network_wall(uid)
+    network, files = worker_walls(uid)
     if network is not None:
         return Isolation(NONE, None, f"{why_not}; {network}")
     return Isolation(UID, uid, why_not, files_open=files or "")
