@@ -9,6 +9,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import eigsh
 from scipy.spatial import cKDTree
 from scipy.special import logsumexp
+from threadpoolctl import ThreadpoolController
 
 from pcl_course import cluster as _contract
 from pcl_course.validation import (
@@ -23,6 +24,9 @@ from pcl_course.validation import (
 )
 from solutions._fast.density import density_clusters
 from solutions._fast.lloyd import assign, cluster_sums
+
+# The BLAS libraries loaded (NumPy's and SciPy's OpenBLAS), found once: EM limits their threads.
+_BLAS = ThreadpoolController()
 
 __all__ = [
     "kmeans",
@@ -166,6 +170,15 @@ def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_cova
     max_iter = check_integer(max_iter, "max_iter", low=1)
     tol = check_scalar(tol, "tol", low=0.0)
     reg_covar = check_scalar(reg_covar, "reg_covar", low=0.0)
+    # EM's products are (N, D) x (D, D) and (K, N) x (N, D): waking BLAS's threads costs more than
+    # they save (benchmarks/cases.py's _gmm_case: 20 iterations at 1e5 points took 1.2-1.5 s on
+    # OpenBLAS's two threads, 0.56-0.68 s on one), as scikit-learn's k-means limits them too.
+    with _BLAS.limit(limits=1, user_api="blas"):
+        return _em(points, weights, means, covariances, max_iter, tol, reg_covar)
+
+
+def _em(points, weights, means, covariances, max_iter, tol, reg_covar):
+    """The EM iterations of :func:`gmm_em`, on checked float64 arguments: its return value."""
     lower_bounds = []
     try:
         for t in range(1, max_iter + 1):
