@@ -8,7 +8,8 @@ group exactly as the plain versions, the closed-form eigensolver must match
 LAPACK on flat, linear, isotropic and badly scaled matrices, the Z-order
 leaf search must find the k-d tree's neighbour distances, the grid radius
 count must equal the k-d tree's count at exactly the radius, and the Lanczos
-path of kernel PCA must match the dense solver.
+path of kernel PCA must match the dense solver, and so must the shift-invert
+ARPACK path of the spectral embedding.
 """
 
 import numpy as np
@@ -17,7 +18,7 @@ import pytest
 from scipy.spatial import cKDTree
 
 from grading import REPO_ROOT
-from solutions import downsampling, filters, normals, pca
+from solutions import cluster, downsampling, filters, normals, pca
 from solutions._fast.eig3 import smallest_eigenpair
 from solutions._fast.grid import grid_is_usable, grid_radius_count
 from solutions._fast.knn import leaf_knn
@@ -333,6 +334,30 @@ def test_kernel_pca_lanczos_matches_the_dense_solver(kernel, beta, rng):
         np.abs(alphas.T @ vectors), np.diag(1.0 / np.sqrt(values)), atol=1e-7 / np.sqrt(values.min())
     )
     np.testing.assert_allclose(projections, centred @ alphas, atol=1e-9 * np.abs(projections).max())
+
+
+# --- spectral embedding: shift-invert ARPACK vs dense ------------------------------------
+
+
+@pytest.mark.parametrize("normalized", [True, False])
+def test_spectral_embedding_arpack_matches_the_dense_solver(normalized, rng):
+    """Past cluster._DENSE_EIGH vertices the embedding is ARPACK's, about a shift factorised by
+    SuperLU in symmetric mode: the same eigenvalues and subspace as LAPACK's dense eigh."""
+    n = cluster._DENSE_EIGH + 500
+    points = rng.random((n, 3)) * [4.0, 1.0, 0.2]  # elongated: the small eigenvalues are distinct
+    indptr, indices, weights = cluster.knn_graph(points, 10)
+    values, vectors = cluster.spectral_embedding(indptr, indices, weights, 6, normalized=normalized)
+    degrees = np.add.reduceat(weights, indptr[:-1])
+    scale = 1.0 / np.sqrt(degrees) if normalized else np.ones(n)
+    dense = np.zeros((n, n))
+    rows = np.repeat(np.arange(n), np.diff(indptr))
+    dense[rows, indices] = -weights * scale[rows] * scale[indices]
+    dense[np.diag_indices(n)] = 1.0 if normalized else degrees
+    expected_values, expected_vectors = np.linalg.eigh(dense)
+    np.testing.assert_allclose(values, expected_values[:6], rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(vectors.T @ vectors, np.eye(6), atol=1e-12)
+    # The same subspace: each vector lies in the span of the dense solver's first six.
+    np.testing.assert_allclose(np.linalg.norm(expected_vectors[:, :6].T @ vectors, axis=0), 1.0, atol=1e-8)
 
 
 def test_compiled_kernels_live_in_the_fast_package_only():
