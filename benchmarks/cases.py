@@ -442,15 +442,17 @@ def _dbscan_case(dataset, n, min_samples=16):
 
 
 def _gmm_case(dataset, n, k=4, iterations=20):
-    """``iterations`` of EM from the same parameters in both implementations (``tol`` 0: no early
+    """``iterations`` of EM from the same parameters in every implementation (``tol`` 0: no early
     stop; full covariances, ``reg_covar`` 1e-6): the means ``k`` points of the cloud, each
-    covariance the cloud's own, equal weights."""
+    covariance the cloud's own, equal weights. scikit-learn runs as it comes (BLAS's threads) and
+    on one BLAS thread, as the reference runs its EM."""
 
     def make():
         import warnings
 
         from sklearn.exceptions import ConvergenceWarning
         from sklearn.mixture import GaussianMixture
+        from threadpoolctl import threadpool_limits
 
         from solutions.cluster import gmm_em
 
@@ -468,9 +470,14 @@ def _gmm_case(dataset, n, k=4, iterations=20):
                 warnings.simplefilter("ignore", ConvergenceWarning)
                 return fit.fit(xyz)
 
+        def scikit_learn_one_thread():
+            with threadpool_limits(limits=1, user_api="blas"):
+                return scikit_learn()
+
         return {
             "reference": lambda: gmm_em(xyz, weights, means, covariances, max_iter=iterations, tol=0.0),
             "scikit-learn": scikit_learn,
+            "scikit-learn-1-thread": scikit_learn_one_thread,
         }
 
     target = (FASTEST_PEER, 1.0) if n >= 100_000 else None
