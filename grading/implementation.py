@@ -70,13 +70,23 @@ def same_bits(before, after):
 
 
 def _modified(before, after, path=()):
-    """Paths of the arrays of ``after`` that differ from those of ``before`` (same structure)."""
+    """Paths of what a call changed of ``before`` (the arguments) in ``after`` (its copies, once
+    called): an array's bits, shape, dtype or writeable flag; a list's or dict's items (a list
+    grown, a key added, an array replaced); a plain item's value. As the sandbox sees them."""
+    here = [list(path)]
     if type(before) is np.ndarray:
-        return [] if same_bits(before, after) else [list(path)]
+        unchanged = type(after) is np.ndarray and same_bits(before, after)
+        return [] if unchanged and before.flags.writeable == after.flags.writeable else here
     if type(before) in (tuple, list):
+        if type(after) is not type(before) or len(after) != len(before):
+            return here
         return [p for i, (b, a) in enumerate(zip(before, after)) for p in _modified(b, a, (*path, i))]
     if type(before) is dict:
+        if type(after) is not dict or list(after) != list(before):
+            return here
         return [p for key in before for p in _modified(before[key], after[key], (*path, key))]
+    if type(before) in (bool, int, float, str, type(None)):
+        return [] if type(after) is type(before) and repr(after) == repr(before) else here
     return []
 
 
@@ -163,7 +173,8 @@ class Implementation:
         self.current_test = None  # the test under way (start_test)
         self.in_place_test = False  # whether it is marked in_place (grading.checks.check_unmodified)
         self.test_grades = {}  # test -> the graded function it grades
-        self.passed_answers = set()  # the tests passed that check answers (not marked interface)
+        self.hidden_tests = set()  # the tests marked hidden (their calls stay out of public verdicts)
+        self.answer_tests = {}  # public test of answers (not marked interface) -> whether it passed
         self.calls = {}  # graded function -> [Call], for the diagnosis
         self.recorder = Recorder()  # what the calls keep, within one budget for the whole grading
         self.worker = None
@@ -252,8 +263,9 @@ class Implementation:
             self.calls.setdefault(name, []).append(call)
             try:
                 result, modified = function(*args, **kwargs)
-            except NotImplementedError:
+            except NotImplementedError as exc:  # a stub; or a path left unwritten, after changing the input
                 call.error_type, call.error = "NotImplementedError", "not implemented"
+                modified = self._modified_by_failed_call(exc)
                 raise NotImplementedYet(name) from None
             except Exception as exc:
                 call.error_type = type(exc).__name__
@@ -264,7 +276,7 @@ class Implementation:
                 call.where = _first_line(getattr(exc, "where", None) or where)  # a file name the submission chose
                 if not hasattr(exc, "raised_by_submission"):
                     exc.raised_by_submission = own
-                modified = getattr(exc, "modified", [])
+                modified = self._modified_by_failed_call(exc)
                 raise
             finally:
                 self.last_modified = argument_names(name, modified)
@@ -282,52 +294,75 @@ class Implementation:
         graded_call.__name__ = name
         return graded_call
 
-    def modified_calls(self, function):
-        """The calls of ``function`` so far in this grading that modified an argument in place.
+    def _modified_by_failed_call(self, exc):
+        """The paths of the arguments a call that raised ``exc`` modified: the exception's own record
+        (the function raised), or the worker's of this call (the worker read the answer, then
+        refused it: a subclass of ndarray, too large, a thread left running)."""
+        if hasattr(exc, "modified"):
+            return exc.modified
+        return self.worker.last_modified if self.worker is not None else []
 
-        Every call counts, in every test: a function that changes its input on one path only
-        (given a Generator, on float64 input, with an option left at its default) is caught by
-        whichever call took that path, which the in-place test's own calls may not. The tests
+    def _public_calls(self, function):
+        """The calls of ``function`` so far in the grading's public tests: what a public test
+        reads of them may depend on nothing a hidden test did (its inputs, its outcome)."""
+        return [call for call in self.calls.get(function, []) if call.test not in self.hidden_tests]
+
+    def modified_calls(self, function):
+        """The calls of ``function`` so far in the public tests that modified an argument in place.
+
+        Every public call counts, in every test: a function that changes its input on one path
+        only (given a Generator, on float64 input, with an option left at its default) is caught
+        by whichever test took that path, which the in-place test's own calls may not. The tests
         that read this verdict (marked ``in_place``) run after the other tests of their function.
-        Returns ``[(argument names, the call described or None, whether the test under way made it)]``.
+        A hidden test's own calls are its own verdict (:meth:`modified_in_test`).
+        Returns ``[(argument names, the call described or None, the test that made it)]``.
         """
         return [
-            (
-                list(call.modified),
-                describe_call(function, call.args, call.kwargs) if call.kept else None,
-                call.test == self.current_test,
-            )
-            for call in self.calls.get(function, [])
+            (list(call.modified), describe_call(function, call.args, call.kwargs) if call.kept else None, call.test)
+            for call in self._public_calls(function)
             if call.modified
         ]
 
-    def start_test(self, test, function, in_place=False):
+    def modified_in_test(self, test):
+        """``[(function, argument names)]`` of the calls test ``test`` made that modified an argument."""
+        return [
+            (function, list(call.modified))
+            for function, calls in self.calls.items()
+            for call in calls
+            if call.test == test and call.modified
+        ]
+
+    def start_test(self, test, function, in_place=False, hidden=False):
         """Called by the plugin as each test's call begins: the calls made now are this test's,
         which grades ``function``; the last call reported in feedback is one of this test's."""
         self.current_test, self.in_place_test = test, in_place
         self.test_grades[test] = function
+        if hidden:
+            self.hidden_tests.add(test)
         self._last_call, self._last_call_text = None, None
 
     def finish_test(self, test, passed, interface):
         """Called by the plugin as each test's call ends: whether it passed, and whether it checks
         answers or only the interface (shapes, errors, in-place changes)."""
-        if passed and not interface:
-            self.passed_answers.add(test)
+        if not interface and test not in self.hidden_tests:
+            self.answer_tests[test] = passed
 
-    def passed_a_test_of_answers(self, function):
-        """Whether a test of ``function``'s answers (not marked interface) has passed so far."""
-        return any(self.test_grades.get(test) == function for test in self.passed_answers)
+    def answers_passed(self, function):
+        """``(passed, run)``: the public tests of ``function``'s answers (not marked interface)
+        run so far, and those passed."""
+        outcomes = [passed for test, passed in self.answer_tests.items() if self.test_grades.get(test) == function]
+        return sum(outcomes), len(outcomes)
 
     def call_counts(self, function):
-        """``(made, returned)``: the calls of ``function`` so far in this grading and those that
+        """``(made, returned)``: the calls of ``function`` so far in the public tests and those that
         returned an answer."""
-        calls = self.calls.get(function, [])
+        calls = self._public_calls(function)
         return len(calls), sum(not call.raised for call in calls)
 
     def sandbox_failure_of(self, function):
-        """``(message, kind)`` when every call of ``function`` so far failed in the sandbox alike
-        (its module cannot be imported, say), else None."""
-        failures = {call.sandbox for call in self.calls.get(function, [])}
+        """``(message, kind)`` when every public call of ``function`` so far failed in the sandbox
+        alike (its module cannot be imported, say), else None."""
+        failures = {call.sandbox for call in self._public_calls(function)}
         return failures.pop() if len(failures) == 1 and None not in failures else None
 
     def not_implemented_in_tests_of(self, function):

@@ -28,6 +28,7 @@ if links := grader_links():  # before another module of the grader is imported
 
 from grading import GRADED_FUNCTIONS, diagnosis, instructors_grader  # noqa: E402
 from grading import config as grading_config  # noqa: E402
+from grading.checks import check_own_calls_unmodified  # noqa: E402
 from grading.diagnosis import Outcome  # noqa: E402
 from grading.errors import SandboxError, TestTimeout  # noqa: E402
 from grading.feedback import classify  # noqa: E402
@@ -331,7 +332,7 @@ def _over_budget(config):
 def pytest_runtest_call(item):
     impl = item.config.stash.get(_IMPL_KEY, None)  # created by the test's setup, the first time
     if impl is not None:
-        impl.start_test(item.nodeid, graded_function(item), in_place=_settles_in_place(item))
+        impl.start_test(item.nodeid, graded_function(item), in_place=_settles_in_place(item), hidden=is_hidden(item))
     if item.stash.get(_FIRED_KEY, False):  # the timer went off before the call (in its setup)
         raise TestTimeout(*item.stash[_TIMEOUT_KEY])
     item.stash[_IN_CALL_KEY] = True
@@ -341,12 +342,22 @@ def pytest_runtest_call(item):
         item.stash[_IN_CALL_KEY] = False
     if item.stash.get(_FIRED_KEY, False):  # a timeout some code caught: the test still timed out
         raise TestTimeout(*item.stash[_TIMEOUT_KEY])
+    if impl is not None and _is_graded(item) and is_hidden(item):
+        check_own_calls_unmodified(impl)  # the public in-place tests never read a hidden test's calls
     return result
 
 
 def pytest_runtest_setup(item):
-    if _is_graded(item) and _over_budget(item.config):
+    # An in-place test runs nothing of the submission's (it reads the verdicts of the calls made):
+    # it is given its due however the budget went, once a call of its function has answered.
+    if _is_graded(item) and _over_budget(item.config) and not _verdicts_to_read(item):
         pytest.skip(f"not run: the submission's time budget of {item.config.getoption('--budget'):g} s ran out")
+
+
+def _verdicts_to_read(item):
+    """Whether ``item`` is an in-place test with calls of its function that answered to read."""
+    impl = item.config.stash.get(_IMPL_KEY, None)
+    return _settles_in_place(item) and impl is not None and impl.call_counts(graded_function(item))[1] > 0
 
 
 def pytest_timeout_set_timer(item, settings):

@@ -21,8 +21,9 @@ The names below are this package's public interface; the rest is private
 to its modules.
 """
 
+from grading.sandbox.arguments import set_generator_state
 from grading.sandbox.bubblewrap import WORKER, WORKER_FILES, masked_paths, site_packages
-from grading.sandbox.client import STRAY_MESSAGE, Worker, set_generator_state
+from grading.sandbox.client import STRAY_MESSAGE, Worker
 from grading.sandbox.processes import kill_uid, living_processes, process_limit, tasks_of_user
 from grading.sandbox.walls import (
     BUBBLEWRAP,

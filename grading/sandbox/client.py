@@ -31,6 +31,8 @@ import numpy as np
 from grading import config, scratch
 from grading.errors import ForbiddenAPI, SandboxError
 from grading.sandbox import mappings, protocol
+from grading.sandbox.arguments import advance_generators, layout, reported_paths
+from grading.sandbox.arguments import arrays as arrays_in
 from grading.sandbox.bubblewrap import (
     WORKER_FILES,
     bubblewrap_command,
@@ -80,6 +82,7 @@ class Worker:
         self.uid = self.isolation.uid
         self.broken = {}  # module -> why it cannot be imported
         self.last_modified = []
+        self._shared = []  # the last call's array arguments in the memfd: (path, array, offset)
         self.known_pids = None  # the worker's processes at the last count (None: not counted yet)
         self.extra = ()  # the running worker's own forbidden names (its module's, FORBIDDEN_IN_MODULE)
         self.exchange = None  # the memfd that holds a call's array arguments, shared with the worker
@@ -276,13 +279,25 @@ class Worker:
                 self.stop()  # a timed-out, broken or forking worker never serves another call
             if from_submission and stray:
                 raise SandboxError(STRAY_MESSAGE, kind=STRAY) from None
+            if from_submission:
+                exc.modified = self._settle_in_place()
             self._refuse_forbidden_mappings(module)
             raise
         if self._stray_tasks():
             self.stop()
             raise SandboxError(STRAY_MESSAGE, kind=STRAY)
+        self._settle_in_place()
         self._refuse_forbidden_mappings(module)
         return result
+
+    def _settle_in_place(self):
+        """Read the shared arguments again once the call's threads have ended (the stray check
+        waited for them): a thread that changed an input after the answer was sent counts too.
+        Returns :attr:`last_modified`, the union of both readings."""
+        again = self._changed_in_place(self._shared) if self._shared else []
+        known = {tuple(path) for path in self.last_modified}
+        self.last_modified = self.last_modified + [path for path in again if tuple(path) not in known]
+        return self.last_modified
 
     def _refuse_forbidden_mappings(self, module):
         """Raise :class:`ForbiddenAPI` if the worker holds a library ``module`` may not use
@@ -313,8 +328,9 @@ class Worker:
 
     def _call(self, module, function, args, kwargs):
         arguments = {"args": list(args), "kwargs": dict(kwargs)}
-        read_only = [path for path, value in _arrays(arguments, []) if not value.flags.writeable]
-        shared, size = _layout(arguments)
+        read_only = [path for path, value in arrays_in(arguments, []) if not value.flags.writeable]
+        shared, size = layout(arguments)
+        self._shared = shared  # read again once the call's threads have ended (_settle_in_place)
         os.ftruncate(self.exchange, 0)  # nothing of an earlier call's
         os.ftruncate(self.exchange, size)
         request = {
@@ -352,8 +368,11 @@ class Worker:
             raise SandboxError(self.broken[module], kind=IMPORT)
         answer = self._read_header(deadline)
         arrays = self._read_arrays(answer.get("arrays", []), deadline)
-        _advance_generators(arguments, answer.get("modified", []))
+        advance_generators(arguments, answer.get("modified", []))
         self.last_modified = self._changed_in_place(shared)
+        for path in reported_paths(arguments, answer.get("reshaped")):
+            if path not in self.last_modified:
+                self.last_modified.append(path)
         if answer.get("ok") is not True:
             if not isinstance(answer.get("type"), str):
                 raise SandboxError("the worker's answer was garbled", kind=GARBLED)
@@ -468,82 +487,6 @@ class _Deadline:
         self.cpu_start = self.usage.start
         self.wall_seconds = self.cpu_seconds * config.CALL_WALL_FACTOR
         self.wall = time.monotonic() + self.wall_seconds
-
-
-def _arrays(value, path):
-    """(path, array) of every ndarray inside nested tuples, lists and dicts."""
-    if type(value) is np.ndarray:
-        yield path, value
-    elif type(value) in (tuple, list):
-        for i, item in enumerate(value):
-            yield from _arrays(item, [*path, i])
-    elif type(value) is dict:
-        for key, item in value.items():
-            yield from _arrays(item, [*path, key])
-
-
-def _layout(arguments):
-    """Where each array argument goes in the shared memory: ([(path, array, offset)], size)."""
-    shared, size = [], 0
-    for path, value in _arrays(arguments, []):
-        if value.dtype.hasobject:
-            continue
-        size = -(-size // 64) * 64  # each array on its own cache line, aligned for any dtype
-        shared.append((path, value, size))
-        size += value.nbytes
-    return shared, size
-
-
-def _advance_generators(arguments, modified):
-    """Give each random generator the call drew from, as the worker names them, the new state the
-    worker sent (checked: one its own stream reaches); their paths. Arrays are not the worker's to
-    report (:meth:`Worker._changed_in_place`)."""
-    if not isinstance(modified, list) or len(modified) > config.MAX_ARRAYS:
-        raise SandboxError("the worker's answer was garbled", kind=GARBLED)
-    paths = []
-    for change in modified:
-        try:
-            target = arguments
-            for step in change["path"]:
-                target = target[step]
-        except (KeyError, IndexError, TypeError):
-            raise SandboxError("the worker's answer was garbled", kind=GARBLED) from None
-        if not isinstance(target, np.random.Generator):
-            raise SandboxError("the worker's answer was garbled", kind=GARBLED)
-        set_generator_state(target, change.get("state"))
-        paths.append(list(change["path"]))
-    return paths
-
-
-def set_generator_state(generator, state):
-    """Give ``generator`` a state the worker sent back, if its own stream could reach it.
-
-    PCG64's state is a position on one stream (``inc``): any 128-bit
-    position on the same stream is one the generator reaches by drawing,
-    any other (another ``inc``, another bit generator, a malformed state)
-    is refused, so that no submission hands the grader a stream of its
-    choosing.
-    """
-    current = generator.bit_generator.state
-    ok = (
-        isinstance(state, dict)
-        and set(state) == set(current)
-        and state.get("bit_generator") == current["bit_generator"] in ("PCG64", "PCG64DXSM")
-        and isinstance(state.get("state"), dict)
-        and set(state["state"]) == {"state", "inc"}
-        and state["state"]["inc"] == current["state"]["inc"]
-        and type(state["state"]["state"]) is int
-        and 0 <= state["state"]["state"] < 2**128
-        and state.get("has_uint32") in (0, 1)
-        and type(state.get("uinteger")) is int
-        and 0 <= state["uinteger"] < 2**32
-    )
-    if not ok:
-        raise SandboxError(
-            "the random generator came back in a state its own stream cannot reach: draw from it, never set it",
-            kind=GENERATOR,
-        )
-    generator.bit_generator.state = state
 
 
 def _exception(answer):

@@ -339,6 +339,35 @@ def _shared(arguments, request, exchange, np):
     return arguments
 
 
+def _shape_of(value, path, np, out):
+    """What a call may change of its arguments besides their arrays' bytes (which the grader reads
+    in the shared memory itself): each list's and dict's items (an array by identity, anything
+    else by type and value) and each array's layout and writeable flag. ``out``: path -> record."""
+    if type(value) in (list, dict):
+        items = list(value.items()) if type(value) is dict else list(enumerate(value))
+        out[tuple(path)] = [
+            (key, id(item) if isinstance(item, np.ndarray) else (type(item), _plain(item))) for key, item in items
+        ]
+        for key, item in items:
+            _shape_of(item, [*path, key], np, out)
+    elif type(value) is tuple:
+        for i, item in enumerate(value):
+            _shape_of(item, [*path, i], np, out)
+    elif isinstance(value, np.ndarray):
+        out[tuple(path)] = (value.shape, value.dtype.str, value.strides, bool(value.flags.writeable))
+
+
+def _plain(item):
+    """A value to compare an item by (its repr: a NaN equals itself, -0.0 differs from 0.0), or its
+    identity where comparing could run its code."""
+    return repr(item) if type(item) in (bool, int, float, str, type(None)) else id(item)
+
+
+def _reshaped(before, after):
+    """The paths (lists) whose record changed between two :func:`_shape_of` readings."""
+    return [list(path) for path, record in before.items() if after.get(path) != record]
+
+
 def _failure(exc):
     frames = traceback.extract_tb(exc.__traceback__)
     own = [f for f in frames if "pcl_course" in f.filename]
@@ -379,6 +408,8 @@ def _call(request, wire, sender, np, exchange=None):
         array.flags.writeable = False
     arguments = _shared(arguments, request, exchange, np)
     watched = [(path, value, value.bit_generator.state) for path, value in _generators(arguments, [], np)]
+    layout = {}
+    _shape_of(arguments, [], np, layout)
     try:
         function = getattr(module, request["function"], None)
         if function is None:
@@ -393,6 +424,9 @@ def _call(request, wire, sender, np, exchange=None):
         if value.bit_generator.state != before:
             modified.append({"path": path, "state": value.bit_generator.state})
     answer["modified"] = modified  # the generators; the grader reads the arrays it shared itself
+    after = {}
+    _shape_of(arguments, [], np, after)
+    answer["reshaped"] = _reshaped(layout, after)  # lists, dicts and arrays' layouts: the worker's word
     sender.send(answer, arrays)
 
 

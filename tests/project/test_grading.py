@@ -776,7 +776,7 @@ def test_a_hidden_test_shows_a_known_mistakes_line_but_never_a_finding_that_quot
     assert "4711" in json.dumps(summary["extra_data"]["all_diagnoses"])  # the instructor sees it
 
 
-CENTRES_SIX_COLUMNS_IN_PLACE = """
+CENTRES_IN_PLACE_WHEN = """
 import numpy as np
 from solutions.pca import *  # noqa: F401,F403
 from solutions.pca import pca as _reference
@@ -784,24 +784,41 @@ from solutions.pca import pca as _reference
 
 def pca(points, correlation=False, sort=True):
     x = np.asarray(points, dtype=float)
-    if x.ndim == 2 and x.shape[1] >= 6 and np.isfinite(x).all():
-        x -= x.mean(axis=0)  # only the hidden test's widest cloud takes this path
+    if x.ndim == 2 and np.isfinite(x).all() and (WHEN):
+        x -= x.mean(axis=0)  # the caller's points move, on this path only
     return _reference(x, correlation=correlation, sort=sort)
 """
 
 
-def test_the_in_place_verdict_is_settled_on_every_call_of_the_grading(tmp_path):
-    """An in-place test reads the calls of every test of its function, the later ones too: the
-    only call that modifies its input is a hidden test's, collected after the in-place test."""
+def _pca_changing_its_input_when(condition, tmp_path):
     module = tmp_path / "pca.py"
-    module.write_text(CENTRES_SIX_COLUMNS_IN_PLACE)
+    module.write_text(CENTRES_IN_PLACE_WHEN.replace("WHEN", condition))
     summary, _ = grade("--reference", "--impl-module", f"pca={module}", "--function", "pca", tmp_path=tmp_path)
-    lost = {t["name"]: t for t in summary["tests"] if t["score"] < t["max_score"]}
+    return summary, {t["name"]: t for t in summary["tests"] if t["score"] < t["max_score"]}
+
+
+def test_the_in_place_verdict_is_settled_on_every_public_call_of_the_grading(tmp_path):
+    """The in-place test reads the calls of every public test of its function, the later ones too:
+    the only call that changes its input is test_pca.py's unsorted one, collected after
+    test_inputs.py (it fails without the plugin's sort), and the message names that test."""
+    summary, lost = _pca_changing_its_input_when("not sort", tmp_path)
     assert list(lost) == ["test_pca_does_not_modify_its_inputs"], list(lost)
     text = lost["test_pca_does_not_modify_its_inputs"]["text"]
-    assert "in the call pca(<array (40, 6) float64>) of another test" in text, text
+    assert "of test_pca_unsorted_result_is_still_an_eigendecomposition)" in text, text
+    assert "np.array(points, dtype=float) copies" in text
     names = [t["name"] for t in summary["tests"]]
-    assert names.index("test_pca_does_not_modify_its_inputs") < names.index("test_pca_hidden_random_clouds")
+    assert names.index("test_pca_does_not_modify_its_inputs") < names.index(
+        "test_pca_unsorted_result_is_still_an_eigendecomposition"
+    )
+
+
+def test_a_hidden_tests_calls_are_its_own_in_place_verdict_and_never_a_public_tests(tmp_path):
+    """Helper h63: a public in-place test that read the hidden tests' calls showed their inputs
+    (a change made only on them named the call) and passed or failed on their outcome. The
+    hidden test now fails on its own calls' changes, and the public test knows nothing of them."""
+    _, lost = _pca_changing_its_input_when("x.shape[1] >= 6", tmp_path)  # the hidden test's widest cloud
+    assert list(lost) == ["test_pca_hidden_random_clouds"], list(lost)
+    assert lost["test_pca_hidden_random_clouds"]["text"].endswith("(hidden test: details withheld)")
 
 
 def test_every_graded_test_that_checks_in_place_changes_is_marked_in_place():
@@ -817,3 +834,32 @@ def test_every_graded_test_that_checks_in_place_changes_is_marked_in_place():
             if "check_unmodified" in calls and "pytest.mark.in_place" not in marks:
                 unmarked.append(f"{path.name}::{node.name}")
     assert not unmarked, unmarked
+
+
+SLOW_PCA = """
+import time
+
+from solutions.pca import *  # noqa: F401,F403
+from solutions.pca import pca as _reference
+
+
+def pca(points, correlation=False, sort=True):
+    time.sleep(0.5)
+    return _reference(points, correlation=correlation, sort=sort)
+"""
+
+
+def test_an_in_place_test_is_given_its_point_after_the_budget_ran_out(tmp_path):
+    """Helper h63: the in-place tests run last and were skipped with the rest once a slow function
+    spent the budget, though they run nothing of the submission's. A function whose calls answered
+    keeps that point (one never reached is not run: the budget tests above)."""
+    module = tmp_path / "pca.py"
+    module.write_text(SLOW_PCA)
+    summary, _ = grade(
+        "--reference", "--impl-module", f"pca={module}", "--function", "voxel_grid_downsample", "--function", "pca",
+        "--budget", "6", tmp_path=tmp_path,
+    )  # fmt: skip
+    scores = {t["name"]: t for t in summary["tests"]}
+    skipped = [t for t in summary["tests"] if "time budget" in t["text"]]
+    assert skipped, "the budget did not run out: make the pca slower"
+    assert scores["test_voxel_grid_downsample_does_not_modify_its_inputs"]["score"] == 1.0

@@ -395,6 +395,124 @@ def test_an_in_place_change_is_a_change_of_bits(tmp_path, level):
         impl.close()
 
 
+CHANGES_BEYOND_BYTES = """
+import threading
+import time
+
+import numpy as np
+
+
+def replace_in_dict(tree, points):
+    tree["split"] = tree["split"] + 1.0  # a new array under the caller's key
+    return np.zeros(1)
+
+
+def add_a_key(tree, points):
+    tree["seen"] = True
+    return np.zeros(1)
+
+
+def grow_a_list(rows):
+    rows.append(rows[0])
+    return np.zeros(1)
+
+
+def change_an_item(rows):
+    rows[0][0] += 1.0
+    return np.zeros(1)
+
+
+def reshape(points):
+    points.shape = (points.size,)
+    return np.zeros(1)
+
+
+def retype(points):
+    points.dtype = np.int64
+    return np.zeros(1)
+
+
+def freeze(points):
+    points.flags.writeable = False
+    return np.zeros(1)
+
+
+def later_in_a_thread(points):
+    def centre():
+        time.sleep(0.3)
+        points[...] -= points.mean(axis=0)
+
+    threading.Thread(target=centre).start()  # it ends within the stray check's grace
+    return np.zeros(1)
+
+
+def then_not_implemented(points):
+    points -= points.mean(axis=0)
+    raise NotImplementedError
+
+
+def then_a_subclass(points):
+    points -= points.mean(axis=0)
+    return np.asmatrix(points)
+
+
+def nan_items_left_alone(rows):
+    return np.zeros(1)
+"""
+
+CHANGED = [
+    ("replace_in_dict", "tree"), ("add_a_key", "tree"), ("grow_a_list", "rows"), ("change_an_item", "rows"),
+    ("reshape", "points"), ("retype", "points"), ("freeze", "points"), ("later_in_a_thread", "points"),
+    ("then_not_implemented", "points"), ("then_a_subclass", "points"),
+]  # fmt: skip
+
+
+def _arguments(name):
+    points = np.random.default_rng(4).random((5, 3)) + 10.0
+    if name in ("replace_in_dict", "add_a_key"):
+        return (), {"tree": {"split": np.arange(3.0), "leaf_size": 16}, "points": points}
+    if "list" in name or "item" in name:
+        return ([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]],), {}
+    if name == "nan_items_left_alone":
+        return ([[np.nan, -0.0, 1.0]],), {}
+    return (points,), {}
+
+
+@pytest.mark.parametrize("level", [*LEVELS, "in-process"])
+def test_a_change_to_an_argument_beyond_its_bytes_is_a_change(tmp_path, level):
+    """Helper h63's review: a dict's array replaced or a key added, a list grown or an item
+    changed, an array's shape, dtype or writeable flag set, a thread that changes the input after
+    the answer, a change then NotImplementedError or an answer the grader refuses: each is an
+    input changed in place, as the caller would see it; a list holding NaN and -0.0, left alone,
+    is not."""
+    namespace = {}
+    exec(CHANGES_BEYOND_BYTES, namespace)
+    impl = None if level == "in-process" else worker_of(tmp_path, level, {"pca": CHANGES_BEYOND_BYTES})
+    try:
+        for name, argument in [*CHANGED, ("nan_items_left_alone", None)]:
+            args, kwargs = _arguments(name)
+            if impl is None:
+                try:
+                    modified = _call_on_copies(namespace[name], args, kwargs)[1]
+                except NotImplementedError as exc:
+                    modified = exc.modified
+                if name == "later_in_a_thread":
+                    continue  # in-process, the thread changes a copy the grader compared already
+            else:
+                try:
+                    impl.call("pca", name, args, kwargs)
+                except (NotImplementedError, SandboxError):
+                    pass
+                modified = impl.last_modified
+            if argument is None:
+                assert modified == [], (name, modified)
+            else:
+                assert modified, name
+    finally:
+        if impl is not None:
+            impl.close()
+
+
 LINGERING = """
 import ctypes
 import os
