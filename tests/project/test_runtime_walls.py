@@ -478,6 +478,7 @@ def _arguments(name):
     return (points,), {}
 
 
+@pytest.mark.filterwarnings("ignore:the matrix subclass:PendingDeprecationWarning")  # then_a_subclass's
 @pytest.mark.parametrize("level", [*LEVELS, "in-process"])
 def test_a_change_to_an_argument_beyond_its_bytes_is_a_change(tmp_path, level):
     """Helper h63's review: a dict's array replaced or a key added, a list grown or an item
