@@ -267,14 +267,16 @@ def _modified_input(function, calls, outcomes, failed, context):
     if not modified:
         return None
     # A failed in-place test is explained even when the modifying calls were other tests'
-    # (it reads every call of the grading: grading.checks.check_unmodified).
+    # (it reads every public call: grading.checks.check_unmodified).
     explained = tuple(
         t for t in failed if any(c.test == t for c in modified) or (outcomes[t].rule or "").startswith(IN_PLACE_RULE)
     )
+    names = sorted({name for c in modified for name in c.modified})
+    name = names[0] if names and names[0].isidentifier() else "x"
     return Diagnosis(
         "modifies_input",
-        f"{function} changed its input array in place ({_plural(len(modified), 'call')}): work on a copy "
-        "(np.array(points, dtype=float) copies; points -= ... does not)",
+        f"{function} changed its input in place ({', '.join(names)}; {_plural(len(modified), 'call')}): work on "
+        f"a copy ({name}.copy(), or np.array({name}, dtype=float); {name} -= ... changes the caller's)",
         explained or tuple(failed),
     )
 

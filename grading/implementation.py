@@ -71,12 +71,12 @@ def same_bits(before, after):
 
 def _modified(before, after, path=()):
     """Paths of what a call changed of ``before`` (the arguments) in ``after`` (its copies, once
-    called): an array's bits, shape, dtype or writeable flag; a list's or dict's items (a list
-    grown, a key added, an array replaced); a plain item's value. As the sandbox sees them."""
+    called): an array's bits, shape or dtype; a list's or dict's items (a list grown, a key added,
+    an array replaced); a plain item's value. As the sandbox sees them. (A writeable flag set
+    changes no value: a function may lock its input against itself.)"""
     here = [list(path)]
     if type(before) is np.ndarray:
-        unchanged = type(after) is np.ndarray and same_bits(before, after)
-        return [] if unchanged and before.flags.writeable == after.flags.writeable else here
+        return [] if type(after) is np.ndarray and same_bits(before, after) else here
     if type(before) in (tuple, list):
         if type(after) is not type(before) or len(after) != len(before):
             return here
@@ -366,9 +366,9 @@ class Implementation:
         return failures.pop() if len(failures) == 1 and None not in failures else None
 
     def not_implemented_in_tests_of(self, function):
-        """The graded function whose stub stopped a test of ``function`` (a call that raised
-        NotImplementedError in one of its tests: its own, or one it needs first), or None."""
-        tests = {test for test, graded in self.test_grades.items() if graded == function}
+        """The graded function whose stub stopped a public test of ``function`` (a call that raised
+        NotImplementedError in one of them: its own, or one it needs first), or None."""
+        tests = {test for test, graded in self.test_grades.items() if graded == function} - self.hidden_tests
         for name, calls in self.calls.items():
             if any(call.test in tests and call.error_type == "NotImplementedError" for call in calls):
                 return name

@@ -212,7 +212,7 @@ def check_own_calls_unmodified(impl):
 
 def _copy_hint(names):
     name = names[0] if names and names[0].isidentifier() else "x"
-    return f": work on a copy (np.array({name}, dtype=float) copies; {name} -= ... does not)"
+    return f": work on a copy ({name}.copy(), or np.array({name}, dtype=float); {name} -= ... changes the caller's)"
 
 
 # The rule of a ValueError that does not name the bad argument (``raises(..., naming=...)``),

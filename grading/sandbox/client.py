@@ -255,7 +255,7 @@ class Worker:
         left it, as it does in-process: drawing from it is its use, not a
         change of an input (a function of ``rng`` must draw).
         """
-        self.last_modified = []
+        self.last_modified, self._shared = [], []
         if module in self.broken:
             raise SandboxError(self.broken[module], kind=IMPORT)
         extra = tuple(config.FORBIDDEN_IN_MODULE.get(module, ()))
@@ -275,17 +275,23 @@ class Worker:
         except BaseException as exc:
             from_submission = getattr(exc, "from_submission", False)
             stray = self._stray_tasks() if self.process is not None else False
+            # The shared memory is the grader's: read whatever became of the worker (a change,
+            # then a timeout, a crash or a thread left running, is a change all the same).
+            modified = self._settle_in_place()
             if not from_submission or stray:
                 self.stop()  # a timed-out, broken or forking worker never serves another call
             if from_submission and stray:
-                raise SandboxError(STRAY_MESSAGE, kind=STRAY) from None
-            if from_submission:
-                exc.modified = self._settle_in_place()
+                error = SandboxError(STRAY_MESSAGE, kind=STRAY)
+                error.modified = modified
+                raise error from None
+            exc.modified = modified
             self._refuse_forbidden_mappings(module)
             raise
         if self._stray_tasks():
+            error = SandboxError(STRAY_MESSAGE, kind=STRAY)
+            error.modified = self._settle_in_place()
             self.stop()
-            raise SandboxError(STRAY_MESSAGE, kind=STRAY)
+            raise error
         self._settle_in_place()
         self._refuse_forbidden_mappings(module)
         return result
@@ -294,7 +300,7 @@ class Worker:
         """Read the shared arguments again once the call's threads have ended (the stray check
         waited for them): a thread that changed an input after the answer was sent counts too.
         Returns :attr:`last_modified`, the union of both readings."""
-        again = self._changed_in_place(self._shared) if self._shared else []
+        again = self._changed_in_place(self._shared) if self._shared and self.exchange is not None else []
         known = {tuple(path) for path in self.last_modified}
         self.last_modified = self.last_modified + [path for path in again if tuple(path) not in known]
         return self.last_modified
@@ -333,6 +339,8 @@ class Worker:
         self._shared = shared  # read again once the call's threads have ended (_settle_in_place)
         os.ftruncate(self.exchange, 0)  # nothing of an earlier call's
         os.ftruncate(self.exchange, size)
+        for _, value, offset in shared:  # written here first: what the memory holds is an argument or its change
+            os.pwrite(self.exchange, np.ascontiguousarray(value).reshape(-1).view(np.uint8), offset)
         request = {
             "module": module,
             "function": function,

@@ -339,22 +339,25 @@ def _shared(arguments, request, exchange, np):
     return arguments
 
 
-def _shape_of(value, path, np, out):
+def _shape_of(value, path, np, out, kept):
     """What a call may change of its arguments besides their arrays' bytes (which the grader reads
     in the shared memory itself): each list's and dict's items (an array by identity, anything
-    else by type and value) and each array's layout and writeable flag. ``out``: path -> record."""
+    else by type and value) and each array's shape, dtype and strides (a writeable flag set
+    changes no value). ``out``: path -> record; ``kept``: every array seen, held so that no
+    new array can take a replaced one's identity."""
     if type(value) in (list, dict):
         items = list(value.items()) if type(value) is dict else list(enumerate(value))
         out[tuple(path)] = [
             (key, id(item) if isinstance(item, np.ndarray) else (type(item), _plain(item))) for key, item in items
         ]
         for key, item in items:
-            _shape_of(item, [*path, key], np, out)
+            _shape_of(item, [*path, key], np, out, kept)
     elif type(value) is tuple:
         for i, item in enumerate(value):
-            _shape_of(item, [*path, i], np, out)
+            _shape_of(item, [*path, i], np, out, kept)
     elif isinstance(value, np.ndarray):
-        out[tuple(path)] = (value.shape, value.dtype.str, value.strides, bool(value.flags.writeable))
+        kept.append(value)
+        out[tuple(path)] = (value.shape, value.dtype.str, value.strides)
 
 
 def _plain(item):
@@ -408,8 +411,8 @@ def _call(request, wire, sender, np, exchange=None):
         array.flags.writeable = False
     arguments = _shared(arguments, request, exchange, np)
     watched = [(path, value, value.bit_generator.state) for path, value in _generators(arguments, [], np)]
-    layout = {}
-    _shape_of(arguments, [], np, layout)
+    layout, kept = {}, []
+    _shape_of(arguments, [], np, layout, kept)
     try:
         function = getattr(module, request["function"], None)
         if function is None:
@@ -425,7 +428,7 @@ def _call(request, wire, sender, np, exchange=None):
             modified.append({"path": path, "state": value.bit_generator.state})
     answer["modified"] = modified  # the generators; the grader reads the arrays it shared itself
     after = {}
-    _shape_of(arguments, [], np, after)
+    _shape_of(arguments, [], np, after, kept)
     answer["reshaped"] = _reshaped(layout, after)  # lists, dicts and arrays' layouts: the worker's word
     sender.send(answer, arrays)
 

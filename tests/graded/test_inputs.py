@@ -1,11 +1,11 @@
 """Graded tests of the contract's general rule that inputs are never modified in place
 (``course-api.md``): one test per graded function, ``test_<function>_does_not_modify_its_inputs``.
 
-Each makes no call of its own: it reads the verdict of every call of its function in the grading
-(:func:`grading.checks.check_unmodified`), and its ``in_place`` marker runs it after the function's
-other tests, hidden ones included. A function that changes float64 input on one path only (an
-option at its default, a Generator, a width no public test uses) loses this point whichever test
-took that path. The tests are made from ``grading.GRADED_FUNCTIONS``: a new graded function gets
+Each makes no call of its own: it reads the verdict of every call of its function in the public
+tests (:func:`grading.checks.check_unmodified`), and its ``in_place`` marker runs it after the
+function's other tests. A function that changes float64 input on one path only (an option at its
+default, a Generator) loses this point whichever public test took that path; a hidden test fails
+on its own calls' changes. The tests are made from ``grading.GRADED_FUNCTIONS``: a new graded function gets
 one without an edit here."""
 
 import pytest
@@ -22,7 +22,7 @@ def _test_of(function):
     def test(impl):
         check_unmodified(impl, function, answered=True)
 
-    test.__doc__ = f"No call of {function} in the grading changed an input array in place."
+    test.__doc__ = f"No call of {function} in the public tests changed an input in place."
     return test
 
 

@@ -280,12 +280,12 @@ def test_signature_is_silent_for_the_contracts_order_or_without_errors(source, k
 
 def test_modified_input_names_the_calls_and_their_tests():
     """A call that changed its argument: the count of such calls, and the failed tests they are in."""
-    calls = [answered("t1", cloud(2), np.zeros(3), modified=True), answered("t2", cloud(2), np.zeros(3))]
+    calls = [answered("t1", cloud(2), np.zeros(3), modified=("points",)), answered("t2", cloud(2), np.zeros(3))]
     found = run(_modified_input, calls, failed("t1", "t2"))
-    assert found.id == "modifies_input" and "changed its input array in place (1 call)" in found.message
+    assert found.id == "modifies_input" and "changed its input in place (points; 1 call)" in found.message
     assert found.explains == ("t1",)
     # Modified only in a passed test: every failed test is put down to it.
-    calls = [answered("t1", cloud(2), np.zeros(3), modified=True), answered("t2", cloud(2), np.zeros(3))]
+    calls = [answered("t1", cloud(2), np.zeros(3), modified=("points",)), answered("t2", cloud(2), np.zeros(3))]
     assert run(_modified_input, calls, {**passed("t1"), **failed("t2")}).explains == ("t2",)
 
 
@@ -629,7 +629,7 @@ def test_random_a_mismatch_contradicts_the_mistake():
 
 def test_diagnose_says_nothing_without_a_failed_test():
     """All tests passed: no diagnosis, even with an input modified in place."""
-    calls = [answered("t1", cloud(2), np.zeros(3), modified=True)]
+    calls = [answered("t1", cloud(2), np.zeros(3), modified=("points",))]
     assert diagnose(FUNCTION, calls, passed("t1")) is None
 
 
@@ -637,7 +637,7 @@ def test_diagnose_stops_at_the_first_finding():
     """An input modified in place comes before a known mistake that the answers also show."""
     calls = [answered(t, cloud(3, shift=i), sums(cloud(3, shift=i))) for i, t in enumerate(("t1", "t2"))]
     assert diagnose(FUNCTION, calls, failed("t1", "t2"), model=catalogue(SUMS)).id == "sums"
-    calls[0].modified = True
+    calls[0].modified = ("points",)
     assert diagnose(FUNCTION, calls, failed("t1", "t2"), model=catalogue(SUMS)).id == "modifies_input"
 
 

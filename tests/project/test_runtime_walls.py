@@ -462,7 +462,7 @@ def nan_items_left_alone(rows):
 
 CHANGED = [
     ("replace_in_dict", "tree"), ("add_a_key", "tree"), ("grow_a_list", "rows"), ("change_an_item", "rows"),
-    ("reshape", "points"), ("retype", "points"), ("freeze", "points"), ("later_in_a_thread", "points"),
+    ("reshape", "points"), ("retype", "points"), ("later_in_a_thread", "points"),
     ("then_not_implemented", "points"), ("then_a_subclass", "points"),
 ]  # fmt: skip
 
@@ -482,15 +482,15 @@ def _arguments(name):
 @pytest.mark.parametrize("level", [*LEVELS, "in-process"])
 def test_a_change_to_an_argument_beyond_its_bytes_is_a_change(tmp_path, level):
     """Helper h63's review: a dict's array replaced or a key added, a list grown or an item
-    changed, an array's shape, dtype or writeable flag set, a thread that changes the input after
-    the answer, a change then NotImplementedError or an answer the grader refuses: each is an
-    input changed in place, as the caller would see it; a list holding NaN and -0.0, left alone,
-    is not."""
+    changed, an array's shape or dtype set, a thread that changes the input after the answer, a
+    change then NotImplementedError or an answer the grader refuses: each is an input changed in
+    place, as the caller would see it. A list holding NaN and -0.0, left alone, is not; nor is a
+    writeable flag cleared (helper h64: it changes no value, and honest code locks its input)."""
     namespace = {}
     exec(CHANGES_BEYOND_BYTES, namespace)
     impl = None if level == "in-process" else worker_of(tmp_path, level, {"pca": CHANGES_BEYOND_BYTES})
     try:
-        for name, argument in [*CHANGED, ("nan_items_left_alone", None)]:
+        for name, argument in [*CHANGED, ("nan_items_left_alone", None), ("freeze", None)]:
             args, kwargs = _arguments(name)
             if impl is None:
                 try:
@@ -646,3 +646,36 @@ def test_a_rules_uid_barred_by_an_earlier_set_of_rules_is_let_through():
     assert bar_forbidden_packages() is None
     assert str(cluster_uid) not in entries(spatial[0])
     assert str(rules_uid(config.SANDBOX_UID_BASE, nn_rules)) in entries(spatial[0])
+
+
+CHANGE_THEN_HANG = """
+import time
+
+
+def change_then_hang(points):
+    points[0, 0] = -1.0
+    while True:
+        time.sleep(0.05)
+
+
+def hang(points):
+    while True:
+        time.sleep(0.05)
+"""
+
+
+@pytest.mark.parametrize("level", LEVELS)
+def test_a_change_before_a_timeout_is_a_change(tmp_path, level):
+    """Helper h64: the shared memory was not read after a timeout, so a change made before the call
+    hung kept the in-place point. The grader writes the arguments there itself, so a call that
+    changed nothing reads as such after a timeout too."""
+    impl = worker_of(tmp_path, level, {"pca": CHANGE_THEN_HANG}, timeout=1)
+    points = np.random.default_rng(5).random((6, 3))
+    try:
+        for name, changed in (("change_then_hang", [["args", 0]]), ("hang", [])):
+            with pytest.raises(SandboxError) as caught:
+                impl.call("pca", name, (points,), {})
+            assert caught.value.kind == SandboxError.TIMEOUT
+            assert caught.value.modified == changed == impl.last_modified, name
+    finally:
+        impl.close()
