@@ -82,7 +82,11 @@ def test_lists_for_arrays_are_named_in_every_test_not_hidden_behind_the_tests_ow
     arguments = ("--reference", "--impl-module", f"nn={module}", "--function", "bst_build")
     summary, _ = run_grader(*arguments, "--function", "knn_result_set", tmp_path=tmp_path)
     public = [t for t in summary["tests"] if t["visibility"] == "visible" and t["status"] == "failed"]
+    # The in-place tests make no call: theirs is the point no answer test earned (checked apart).
+    in_place = [t for t in public if t["name"].endswith("_does_not_modify_its_inputs")]
+    public = [t for t in public if t not in in_place]
     assert len(public) >= 6
+    assert all("tests of" in t["text"] and "answers passed" in t["text"] for t in in_place), in_place
     for test in public:
         assert "must be a plain numpy.ndarray, got builtins.list" in test["text"], test["text"]
         assert "tolist" not in test["text"] and "recursive call" not in test["text"], test["text"]

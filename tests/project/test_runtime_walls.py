@@ -126,7 +126,7 @@ def visible(folders):
 
 def worker_of(tmp_path, level, modules, timeout=20):
     """A worker on a package of ``modules`` (name -> source) at ``level``: "strongest", "uid", or
-    "uid-open" (a dedicated uid on a kernel without Landlock)."""
+    "uid-open" (a dedicated uid on a kernel without Landlock). ``timeout``: a call's CPU seconds."""
     package = tmp_path / "clone" / "pcl_course"
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")

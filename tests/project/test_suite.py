@@ -11,7 +11,7 @@ from grading import REPO_ROOT
 SOURCES = sorted((REPO_ROOT / "tests" / "project").glob("*.py")) + [REPO_ROOT / "tests" / "_helpers.py"]
 # Calls whose ``timeout`` is CPU seconds (grading.sandbox.Worker's, the limit of a submission's
 # call), which load does not consume: a number is right there.
-CPU_TIME_LIMITS = {"Worker", "hostile_worker", "make_worker"}
+CPU_TIME_LIMITS = {"Worker", "hostile_worker", "make_worker", "worker_of"}
 
 
 def _bare_timeouts(path):
