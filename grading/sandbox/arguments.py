@@ -12,16 +12,20 @@ GARBLED, GENERATOR = SandboxError.GARBLED, SandboxError.GENERATOR
 __all__ = ["advance_generators", "arrays", "layout", "reported_paths", "set_generator_state"]
 
 
-def arrays(value, path):
-    """(path, array) of every ndarray inside nested tuples, lists and dicts."""
-    if type(value) is np.ndarray:
-        yield path, value
-    elif type(value) in (tuple, list):
+def _nodes(value, path):
+    """(path, value) of ``value`` and of everything inside its nested tuples, lists and dicts."""
+    yield path, value
+    if type(value) in (tuple, list):
         for i, item in enumerate(value):
-            yield from arrays(item, [*path, i])
+            yield from _nodes(item, [*path, i])
     elif type(value) is dict:
         for key, item in value.items():
-            yield from arrays(item, [*path, key])
+            yield from _nodes(item, [*path, key])
+
+
+def arrays(value, path):
+    """(path, array) of every ndarray inside nested tuples, lists and dicts."""
+    return ((where, node) for where, node in _nodes(value, path) if type(node) is np.ndarray)
 
 
 def layout(arguments):
@@ -38,26 +42,18 @@ def layout(arguments):
 
 def reported_paths(arguments, reported):
     """The paths the worker reported changed besides the shared bytes (a list or dict argument's
-    items, an array's shape, dtype or writeable flag): those that name an argument's list, dict or
-    array here, at most one per such item; anything else is dropped. (The worker's word, unlike
-    the bytes: a submission that rewrites the worker can hide these, and gains nothing else.)"""
-    known = [list(path) for path, _ in _containers_and_arrays(arguments, [])]
+    items, an array's shape or dtype): those that name a list, dict or array inside an argument
+    here (not the call's own args list and kwargs dict, whose paths have one step), at most one
+    per such item; anything else is dropped. (The worker's word, unlike the bytes: a submission
+    that rewrites the worker can hide these, and gains nothing else.)"""
+    known = [
+        list(path)
+        for path, node in _nodes(arguments, [])
+        if len(path) > 1 and (type(node) is np.ndarray or type(node) in (list, dict))
+    ]
     if not isinstance(reported, list):
         return []
     return [path for path in known if path in reported[: len(known) + 1]]
-
-
-def _containers_and_arrays(value, path):
-    """(path, value) of every list, dict and array inside the call's arguments (not the call's own
-    args list and kwargs dict, whose paths have one step)."""
-    if len(path) > 1 and (type(value) is np.ndarray or type(value) in (list, dict)):
-        yield path, value
-    if type(value) in (tuple, list):
-        for i, item in enumerate(value):
-            yield from _containers_and_arrays(item, [*path, i])
-    elif type(value) is dict:
-        for key, item in value.items():
-            yield from _containers_and_arrays(item, [*path, key])
 
 
 def advance_generators(arguments, modified):
