@@ -11,6 +11,7 @@ that.
 
 import os
 import shutil
+import stat
 import tempfile
 import time
 
@@ -62,8 +63,9 @@ def sweep(directory=None):
     """Remove the scratch folders in ``directory`` (the temporary directory) that no living
     process holds. Returns how many were removed.
 
-    Folders of other users, whose lock file this user cannot open, are left alone; so is any
-    entry that is not a plain folder with one of :data:`PREFIXES`.
+    Folders of other users are left alone; so is any entry that is not a plain folder with one of
+    :data:`PREFIXES`. A folder of this user's whose lock is not a regular file of this user's
+    (a directory, a link, another uid's file) is treated as a folder without a lock.
     """
     directory = directory or tempfile.gettempdir()
     removed = 0
@@ -83,14 +85,23 @@ def sweep(directory=None):
 
 
 def _abandoned(entry):
+    lock = os.path.join(entry.path, LOCK)
     try:
-        descriptor = os.open(os.path.join(entry.path, LOCK), os.O_RDWR | os.O_NOFOLLOW)
+        folder = entry.stat(follow_symlinks=False)
+        found = os.lstat(lock)
     except FileNotFoundError:
-        try:
-            return time.time() - entry.stat(follow_symlinks=False).st_mtime > UNLOCKED_AGE
-        except OSError:
-            return False
-    except OSError:  # another user's, or not a lock file
+        return time.time() - folder.st_mtime > UNLOCKED_AGE
+    except OSError:
+        return False
+    if folder.st_uid != os.geteuid():
+        return False  # another user's: theirs to sweep
+    if not stat.S_ISREG(found.st_mode) or found.st_uid != os.geteuid():
+        # Not a lock this user made (folder() makes a regular file of its own): nobody can
+        # hold it, so it is treated as a missing lock, and the folder is swept once old.
+        return time.time() - folder.st_mtime > UNLOCKED_AGE
+    try:
+        descriptor = os.open(lock, os.O_RDWR | os.O_NOFOLLOW)
+    except OSError:
         return False
     try:
         fcntl.flock(descriptor, fcntl.LOCK_EX | fcntl.LOCK_NB)

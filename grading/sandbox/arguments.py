@@ -45,7 +45,9 @@ def reported_paths(arguments, reported):
     items, an array's shape or dtype): those that name a list, dict or array inside an argument
     here (not the call's own args list and kwargs dict, whose paths have one step), at most one
     per such item; anything else is dropped. (The worker's word, unlike the bytes: a submission
-    that rewrites the worker can hide these, and gains nothing else.)"""
+    that rewrites the worker in its own process can hide these changes, and so keep the points
+    that checks of its inputs would cost it, public and hidden; its answers are still checked.
+    The grader cannot see a Python object's layout in another process.)"""
     known = [
         list(path)
         for path, node in _nodes(arguments, [])

@@ -77,7 +77,8 @@ class Worker:
         self.staged_root = Path(staged_root).resolve()
         self.timeout = timeout
         self.process = None
-        self.work = None
+        self.work = None  # the scratch folder: holds the lock, and self.home
+        self.home = None
         self.isolation = level if level is not None else isolation(uid)
         self.uid = self.isolation.uid
         self.broken = {}  # module -> why it cannot be imported
@@ -113,7 +114,7 @@ class Worker:
             str(self.staged_root),
             *tail,
         ]
-        return python, environment(self.work)
+        return python, environment(self.home)
 
     def start(self):
         become_subreaper()
@@ -125,9 +126,15 @@ class Worker:
             # from), by no other sandbox uid: a classmate's is out of reach.
             os.chown(self.staged_root, 0, self.uid)
             os.chmod(self.staged_root, 0o750)
-        self.work = scratch.folder("grading-home-")  # HOME of the uid and none levels
+        # The scratch folder and its lock stay the grader's; the worker's HOME (uid and none
+        # levels) is a folder inside it, so no submission can unlock it for a sweep.
+        self.work = scratch.folder("grading-home-")
+        self.home = os.path.join(self.work, "home")
+        os.mkdir(self.home, 0o700)
         if self.uid is not None:
-            os.chown(self.work, self.uid, self.uid)
+            os.chown(self.work, os.geteuid(), self.uid)
+            os.chmod(self.work, 0o710)  # its uid may pass through, to its home, and list nothing
+            os.chown(self.home, self.uid, self.uid)
         self.exchange = os.memfd_create("pcl-call-arguments")
         self.exchange_inode = os.fstat(self.exchange).st_ino
         command, env = self._command()
@@ -139,7 +146,7 @@ class Worker:
             stdout=subprocess.PIPE,
             stderr=self.stderr,
             env=env,
-            cwd=self.work,
+            cwd=self.home,
             preexec_fn=preexec(self.uid),
             pass_fds=(self.exchange,),
         )

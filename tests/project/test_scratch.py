@@ -78,3 +78,51 @@ def test_a_folder_made_and_removed_here_releases_its_lock(tmp_path, monkeypatch)
     assert not os.path.exists(made) and made not in scratch._held
     with pytest.raises(ValueError, match="prefix"):
         scratch.folder("elsewhere-")
+
+
+def test_an_old_folder_whose_lock_is_not_a_file_of_ours_is_swept(tmp_path):
+    hour_ago = time.time() - scratch.UNLOCKED_AGE - 60
+    planted = tmp_path / "grading-staged-planted"
+    (planted / scratch.LOCK).mkdir(parents=True)  # open() of it fails: it used to be kept forever
+    young = tmp_path / "grading-staged-young"
+    (young / scratch.LOCK).mkdir(parents=True)
+    os.utime(planted, (hour_ago, hour_ago))
+    assert scratch.sweep(tmp_path) == 1
+    assert not planted.exists() and young.is_dir()
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="the uid level needs root")
+def test_a_worker_cannot_unlock_the_folder_that_holds_its_home(tmp_path):
+    """The uid's HOME is inside a scratch folder that stays the grader's: the worker can neither
+    take its lock away (for a concurrent sweep to remove the folder mid-grading) nor list it."""
+    from _helpers import staged_root
+
+    from grading.sandbox import UID, Isolation, Worker, reserve_uid
+
+    package = tmp_path / "clone" / "pcl_course"
+    package.mkdir(parents=True)
+    (package / "__init__.py").write_text("")
+    (package / "evil.py").write_text(
+        "import os\n"
+        "def unlock():\n"
+        "    folder = os.path.dirname(os.environ['HOME'])\n"
+        "    tried = []\n"
+        "    for attempt in (lambda: os.rename(os.path.join(folder, '.grading-lock'), os.path.join(folder, 'x')),\n"
+        "                    lambda: os.unlink(os.path.join(folder, '.grading-lock')),\n"
+        "                    lambda: os.listdir(folder)):\n"
+        "        try:\n"
+        "            attempt()\n"
+        "            tried.append('done')\n"
+        "        except OSError as error:\n"
+        "            tried.append(type(error).__name__)\n"
+        "    with open(os.path.join(os.environ['HOME'], 'mine'), 'w') as handle:\n"
+        "        handle.write('a home is still writable')\n"
+        "    return tried\n"
+    )
+    worker = Worker(staged_root(package), timeout=20, level=Isolation(UID, reserve_uid(), "test"))
+    try:
+        assert worker.call("evil", "unlock", (), {}) == ["PermissionError"] * 3
+        assert os.path.isfile(os.path.join(worker.work, scratch.LOCK))
+        assert scratch.sweep(os.path.dirname(worker.work)) == 0 and os.path.isdir(worker.home)
+    finally:
+        worker.stop()
