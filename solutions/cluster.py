@@ -22,7 +22,7 @@ from pcl_course.validation import (
     check_scalar,
 )
 from solutions._fast.density import density_clusters
-from solutions._fast.lloyd import assign, cluster_sums
+from solutions._fast.lloyd import lloyd_pass
 
 # The BLAS libraries loaded (NumPy's and SciPy's OpenBLAS), found once: EM limits their threads.
 _BLAS = ThreadpoolController()
@@ -55,9 +55,13 @@ def _squared_distances(points, centers):
     return s
 
 
-def _means(points, labels, centers):
-    """Each centre moved to the mean of its points (summed in index order); an empty one kept."""
-    sums, counts = cluster_sums(points, labels, len(centers))
+# k-means: a pass that changed more than 1 / _RESUM_FRACTION of the labels is followed by one that
+# sums every cluster anew (updated sums would carry the rounding of many additions and subtractions).
+_RESUM_FRACTION = 16
+
+
+def _moved(centers, sums, counts):
+    """Each centre moved to the mean of its points; an empty one kept."""
     filled = counts > 0
     moved = centers.copy()
     moved[filled] = sums[filled] / counts[filled, None]
@@ -66,7 +70,7 @@ def _means(points, labels, centers):
 
 @_documented
 def kmeans(points, init_centers, max_iter=300):
-    points = np.ascontiguousarray(as_points(points, min_columns=1, allow_empty=False))
+    points = as_points(points, min_columns=1, allow_empty=False)
     centers = as_array(init_centers, "init_centers", ndim=2)
     if centers.shape[1] != points.shape[1]:
         raise ValueError(f"init_centers must have {points.shape[1]} columns (the width of points), got {centers.shape}")
@@ -74,20 +78,24 @@ def kmeans(points, init_centers, max_iter=300):
         raise ValueError(f"init_centers must hold 1 to {len(points)} centres (N), got {len(centers)}")
     max_iter = check_integer(max_iter, "max_iter", low=1)
     centers = np.ascontiguousarray(centers, dtype=np.float64).copy()
-    columns = np.ascontiguousarray(points.T)  # the assignment reads a column at a time
-    labels, previous = np.empty(len(points), dtype=np.int64), np.empty(len(points), dtype=np.int64)
-    distances = np.empty(len(points))
+    columns = np.ascontiguousarray(points.T, dtype=np.float64)  # a pass reads a column at a time
+    labels = np.zeros(len(points), dtype=np.int32)  # a pass reads and writes them: half the bytes
     inertia = []
+    sums, counts, changed = None, None, len(points)
     for t in range(1, max_iter + 1):
-        assign(columns, centers, labels, distances)
-        inertia.append(float(distances.sum()))
-        if t > 1 and np.array_equal(labels, previous):
+        # Once few labels change, the sums are updated by the points that moved (their rounding
+        # is that of those few additions). The first pass, and any after one that moved many
+        # (moves dwindle from pass to pass: the last count foretells the next), sum them whole.
+        full = changed > len(points) // _RESUM_FRACTION
+        found, found_counts, total, changed = lloyd_pass(columns, centers, labels, full)
+        sums, counts = (found, found_counts) if full else (sums + found, counts + found_counts)
+        inertia.append(total)
+        if t > 1 and changed == 0:
             break
-        centers = _means(points, labels, centers)
-        labels, previous = previous, labels
+        centers = _moved(centers, sums, counts)
         if t == max_iter:
-            assign(columns, centers, labels, distances)
-    return labels, centers, np.array(inertia), len(inertia)
+            lloyd_pass(columns, centers, labels)
+    return labels.astype(np.int64), centers, np.array(inertia), len(inertia)
 
 
 @_documented

@@ -16,7 +16,7 @@ module      what
 ``rows``    the trees' shared pieces: distances, sorted CSR rows, rows un-permuted
 ``bst``     lecture 2's result set and binary search tree
 ``sorting`` in-place introsort of a range, alone or with a payload
-``lloyd``   lecture 3's k-means: the nearest-centre assignment, the sums in index order
+``lloyd``   lecture 3's k-means: one pass per iteration (assignment, sums, inertia, changes)
 ``density`` lecture 3's DBSCAN: neighbours from candidate pairs, union-find of the cores
 ==========  ============================================================
 

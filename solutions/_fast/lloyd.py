@@ -1,32 +1,47 @@
-"""Lloyd's iterations (k-means): the nearest-centre assignment on every core, the sums in index order (numba)."""
+"""Lloyd's iterations (k-means): one pass over the points per iteration, on every core (numba).
+
+A pass assigns each point to its nearest centre and, while the point is in the first-level cache,
+adds it to its cluster's sum, its squared distance to the inertia and whether its label changed to
+a count: the points are read once per iteration, not four times (assignment, sums, comparison of
+the labels, inertia), which is what bounds the time on a million points (memory traffic, not
+arithmetic).
+"""
 
 import numpy as np
 from numba import njit
 
-from solutions._fast.threads import in_threads
+from solutions._fast.threads import map_slices
 
-__all__ = ["assign", "cluster_sums"]
+__all__ = ["lloyd_pass"]
 
-# Points per slice of the assignment: below, a thread costs more than it saves (measured: one
-# thread assigns 1e5 points to 8 centres in 0.9 ms; in slices of 16,384 on two threads, 1.7 ms).
-_ASSIGN_GRAIN = 131_072
-# Points whose squared distances to one centre are summed together: the loops over them are
-# vectorised, and a block's distances stay in the first-level cache.
+# Points per slice of a pass: below, a thread costs more than it saves.
+_GRAIN = 65_536
+# Points assigned together: the loops over them are vectorised, and a block's distances stay in
+# the first-level cache.
 _BLOCK = 256
 
 
 @njit(cache=True, nogil=True)
-def _assign_slice(columns, centers, first, last, labels, distances):
-    """Points ``first..last-1`` of ``columns`` (D, N): each point's nearest centre by the squared
+def _pass_slice(columns, centers, first, last, labels, full):
+    """Points ``first..last-1`` of ``columns`` (D, N): each one's nearest centre by the squared
     distance summed over the columns in increasing order (the contract's), ties to the lowest index
-    (a strict ``<``: a later centre wins only if nearer)."""
+    (a strict ``<``: a later centre wins only if nearer), written into ``labels``.
+
+    Returns ``(sums (K, D), counts (K,), inertia, changed)``: with ``full``, each cluster's sum and
+    number of points; otherwise what they gained less what they lost (a point that changed label
+    is added to its new cluster and subtracted from its old one, from the labels ``labels`` held).
+    ``changed`` counts the labels that differ from those ``labels`` held."""
     k, d = centers.shape
     s = np.empty(_BLOCK)
+    best = np.empty(_BLOCK)
+    label = np.empty(_BLOCK, dtype=labels.dtype)
+    sums = np.zeros((k, d))
+    counts = np.zeros(k, dtype=np.int64)
+    lane_inertia = np.zeros(_BLOCK)
+    changed = 0
     for start in range(first, last, _BLOCK):
         stop = min(start + _BLOCK, last)
         m = stop - start
-        best = distances[start:stop]
-        label = labels[start:stop]
         for i in range(m):
             best[i] = np.inf
             label[i] = 0
@@ -43,31 +58,42 @@ def _assign_slice(columns, centers, first, last, labels, distances):
                 nearer = s[i] < best[i]
                 best[i] = s[i] if nearer else best[i]
                 label[i] = c if nearer else label[i]
+        block_changed = 0
+        for i in range(m):
+            lane_inertia[i] += best[i]
+            block_changed += label[i] != labels[start + i]
+        changed += block_changed
+        if full:
+            for i in range(m):
+                c = label[i]
+                counts[c] += 1
+                for j in range(d):
+                    sums[c, j] += columns[j, start + i]
+        elif block_changed:
+            for i in range(m):
+                new, old = label[i], labels[start + i]
+                if new != old:
+                    counts[new] += 1
+                    counts[old] -= 1
+                    for j in range(d):
+                        sums[new, j] += columns[j, start + i]
+                        sums[old, j] -= columns[j, start + i]
+        for i in range(m):
+            labels[start + i] = label[i]
+    return sums, counts, lane_inertia.sum(), changed
 
 
-def assign(columns, centers, labels=None, distances=None):
-    """Each point's nearest centre and its squared distance, for the points as ``columns`` (D, N)
-    (``points.T``, contiguous): ``labels`` (N,) int64 and ``distances`` (N,), written into the
-    arrays given (no new pages to fault in at every iteration of a million points) or new ones."""
-    n = columns.shape[1]
-    labels = np.empty(n, dtype=np.int64) if labels is None else labels
-    distances = np.empty(n) if distances is None else distances
-    in_threads(_assign_slice, n, (columns, centers), (labels, distances), grain=_ASSIGN_GRAIN)
-    return labels, distances
+def lloyd_pass(columns, centers, labels, full=True):
+    """One assignment of the points ``columns`` (D, N) (``points.T``, contiguous) to ``centers``
+    (K, D), written into ``labels`` (N,) int32 or int64 (the previous assignment; anything, with ``full``):
+    ``(sums, counts, inertia, changed)``, the sum (K, D) and number (K,) of each cluster's points
+    (with ``full``; otherwise their changes since ``labels``' assignment), the sum of the points'
+    squared distances to their centres, and how many labels changed."""
 
+    def one_slice(first, last):
+        return _pass_slice(columns, centers, first, last, labels, full)
 
-@njit(cache=True, nogil=True)
-def cluster_sums(points, labels, k):
-    """The sum of each cluster's points (K, D), each in index order, and its count (K,) int64.
-
-    Row by row: the D sums a point adds to are independent, so their additions overlap (column by
-    column, each sum waits for its previous addition: three times as slow, measured)."""
-    n, d = points.shape
-    sums = np.zeros((k, d))
-    counts = np.zeros(k, dtype=np.int64)
-    for i in range(n):
-        c = labels[i]
-        counts[c] += 1
-        for j in range(d):
-            sums[c, j] += points[i, j]
-    return sums, counts
+    parts = map_slices(one_slice, columns.shape[1], (), grain=_GRAIN)
+    sums = np.sum([part[0] for part in parts], axis=0)
+    counts = np.sum([part[1] for part in parts], axis=0)
+    return sums, counts, float(sum(part[2] for part in parts)), int(sum(part[3] for part in parts))

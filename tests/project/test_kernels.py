@@ -242,26 +242,38 @@ def _sort_cases():
     yield "organ pipe", np.r_[np.arange(1500.0), np.arange(1500.0)[::-1]]
 
 
-# --- lecture 3: Lloyd's assignment and sums ----------------------------------------------------
+# --- lecture 3: Lloyd's passes ----------------------------------------------------------------
 
 
 @pytest.mark.parametrize("name", CLOUDS)
 def test_lloyd_under_stress(name):
+    """A pass's labels against argmin (the first of equal distances), its inertia against the sum of
+    the minima, and its sums: whole ones against np.add.at, changes against the difference of two
+    whole ones (to rounding: another order of the same additions)."""
     points = CLOUDS[name]
     rng = np.random.default_rng(len(points))
+    columns = np.ascontiguousarray(points.T)
     for k in sorted({1, min(3, len(points)), len(points)}):
         # Centres on points (exact ties where points repeat) and a copy of the first (a tie for all).
         centers = np.vstack([points[rng.choice(len(points), k, replace=False)], points[:1]])
-        columns = np.ascontiguousarray(points.T)
-        labels, distances = lloyd.assign(columns, centers)
         s = sum((points[:, j, None] - centers[None, :, j]) ** 2 for j in range(points.shape[1]))
-        np.testing.assert_array_equal(labels, np.argmin(s, axis=1), err_msg=f"k={k}")
-        np.testing.assert_array_equal(distances, s.min(axis=1))
-        sums, counts = lloyd.cluster_sums(np.ascontiguousarray(points), labels, len(centers))
-        np.testing.assert_array_equal(counts, np.bincount(labels, minlength=len(centers)))
-        expected = np.zeros_like(sums)
-        np.add.at(expected, labels, points)  # in index order, as the kernel
-        np.testing.assert_array_equal(sums, expected)
+        expected = np.argmin(s, axis=1)
+        previous = rng.integers(len(centers), size=len(points)).astype(np.int32)  # as kmeans keeps them
+        labels = previous.copy()
+        sums, counts, inertia, changed = lloyd.lloyd_pass(columns, centers, labels, full=True)
+        np.testing.assert_array_equal(labels, expected, err_msg=f"k={k}")
+        assert changed == np.count_nonzero(previous != expected)
+        np.testing.assert_allclose(inertia, s.min(axis=1).sum(), rtol=1e-12)
+        np.testing.assert_array_equal(counts, np.bincount(expected, minlength=len(centers)))
+        whole = np.zeros_like(sums)
+        np.add.at(whole, expected, points)
+        np.testing.assert_allclose(sums, whole, rtol=1e-12, atol=1e-9)
+        labels = previous.copy()
+        gained, gained_counts, _, _ = lloyd.lloyd_pass(columns, centers, labels, full=False)
+        before = np.zeros_like(sums)
+        np.add.at(before, previous, points)
+        np.testing.assert_array_equal(gained_counts, counts - np.bincount(previous, minlength=len(centers)))
+        np.testing.assert_allclose(before + gained, whole, rtol=1e-12, atol=1e-9)
 
 
 @pytest.mark.parametrize("name", CLOUDS)
