@@ -411,8 +411,14 @@ def _kmeans_case(dataset, n, k=8, iterations=30):
             "scipy-kmeans2": scipy_kmeans2,
         }
 
+    from solutions._fast.lloyd import _GRAIN
+    from solutions.cluster import _RESUM_FRACTION
+
+    # How the reference ran, for the appendix to state (the book cannot import the reference:
+    # it is not in the students' repository).
+    how = {"reference_resum_fraction": _RESUM_FRACTION, "reference_threads_from": 2 * _GRAIN}
     target = (FASTEST_PEER, 1.0) if n >= 100_000 else None
-    return Case("kmeans", f"k{k}", dataset, n, make, {"k": k, "iterations": iterations}, target)
+    return Case("kmeans", f"k{k}", dataset, n, make, {"k": k, "iterations": iterations, **how}, target)
 
 
 def _dbscan_case(dataset, n, min_samples=16):
