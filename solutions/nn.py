@@ -155,18 +155,18 @@ def kdtree_knn(tree, points, queries, k):
 
 
 def _knn_in_locality_order(kernel, arrays, points, queries, k):
-    """Run a kNN kernel over every core, on the queries in Z-order when there are many."""
-    permutation = None
+    """Run a kNN kernel over every core, on the queries in Z-order when there are many.
+
+    The kernel reads the queries in that order and writes each answer to its query's own row:
+    neither the queries nor the answers are copied into Z-order and back (at 1e6 queries, putting
+    the answers back took a sixth of the search)."""
     if len(queries) >= threshold(_LOCALITY_QUERIES) and queries.shape[1] >= 3:
-        permutation = morton_order(queries[:, :3])
-        queries = np.ascontiguousarray(queries[permutation])
+        rows = morton_order(queries[:, :3])
+    else:
+        rows = np.arange(len(queries))
     indices = np.empty((len(queries), k), dtype=np.int64)
     distances = np.empty((len(queries), k))
-    in_threads(kernel, len(queries), (*arrays, points, queries, k), (indices, distances), grain=1024)
-    if permutation is not None:
-        unsorted_indices, unsorted_distances = indices, distances
-        indices, distances = np.empty_like(indices), np.empty_like(distances)
-        indices[permutation], distances[permutation] = unsorted_indices, unsorted_distances
+    in_threads(kernel, len(queries), (*arrays, points, queries, rows, k), (indices, distances), grain=1024)
     return indices, distances
 
 

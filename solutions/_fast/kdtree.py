@@ -177,14 +177,19 @@ def offer(s, index, held_s, held_i, count, k):
 
 
 @njit(cache=True, nogil=True)
-def knn(order, start, stop, axis, split, left, right, stack_size, points, queries, k, first, last, indices, distances):
-    """k nearest neighbours of ``queries[first:last]`` into ``indices``/``distances`` (the contract's rule)."""
+def knn(
+    order, start, stop, axis, split, left, right, stack_size, points, queries, rows, k, first, last, indices, distances
+):
+    """k nearest neighbours of ``queries[rows[first:last]]`` into the same rows of ``indices``/``distances``
+    (the contract's rule). ``rows`` is the order in which the queries are searched (see
+    ``solutions.nn._knn_in_locality_order``); their answers go straight to their own rows."""
     stack_node = np.empty(stack_size, dtype=np.int64)  # never grown: a reassigned array slows every access
     stack_d2 = np.empty(stack_size)
     held_s = np.empty(k)
     held_i = np.empty(k, dtype=np.int64)
     for qi in range(first, last):
-        query = queries[qi]
+        row = rows[qi]
+        query = queries[row]
         count = 0
         worst = np.inf
         stack_node[0], stack_d2[0] = 0, 0.0
@@ -208,8 +213,8 @@ def knn(order, start, stop, axis, split, left, right, stack_size, points, querie
             stack_node[top + 1], stack_d2[top + 1] = near, 0.0
             top += 2
         for j in range(k):
-            indices[qi, j] = held_i[j]
-            distances[qi, j] = np.sqrt(held_s[j])
+            indices[row, j] = held_i[j]
+            distances[row, j] = np.sqrt(held_s[j])
 
 
 @njit(cache=True, nogil=True)

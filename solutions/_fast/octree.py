@@ -192,8 +192,11 @@ def radius_rows(order, start, stop, center, extent, children, stack_size, xyz, q
 
 
 @njit(cache=True, nogil=True)
-def knn(order, start, stop, center, extent, children, stack_size, xyz, queries, k, first, last, indices, distances):
-    """k nearest neighbours with the contract's child order and early termination."""
+def knn(
+    order, start, stop, center, extent, children, stack_size, xyz, queries, rows, k, first, last, indices, distances
+):
+    """k nearest neighbours with the contract's child order and early termination, of
+    ``queries[rows[first:last]]`` into the same rows of ``indices``/``distances``."""
     capacity = stack_size  # one frame per level: never grown
     frame_node = np.empty(capacity, dtype=np.int64)
     frame_next = np.empty(capacity, dtype=np.int64)  # -1: not entered yet
@@ -201,7 +204,8 @@ def knn(order, start, stop, center, extent, children, stack_size, xyz, queries, 
     held_s = np.empty(k)
     held_i = np.empty(k, dtype=np.int64)
     for qi in range(first, last):
-        query = queries[qi]
+        row = rows[qi]
+        query = queries[row]
         count = 0
         worst = np.inf
         frame_node[0], frame_next[0] = 0, -1
@@ -255,8 +259,8 @@ def knn(order, start, stop, center, extent, children, stack_size, xyz, queries, 
                 break
             depth -= 1
         for j in range(k):
-            indices[qi, j] = held_i[j]
-            distances[qi, j] = np.sqrt(held_s[j])
+            indices[row, j] = held_i[j]
+            distances[row, j] = np.sqrt(held_s[j])
 
 
 @njit(cache=True, nogil=True)
