@@ -404,12 +404,15 @@ def _kmeans_case(dataset, n, k=8, iterations=30):
             fit = KMeans(k, init=start, n_init=1, max_iter=iterations, tol=0, algorithm=algorithm)
             return lambda: fit.fit(xyz)
 
-        return {
+        implementations = {
             "reference": lambda: kmeans(xyz, start, iterations),
             "scikit-learn-lloyd": scikit_learn("lloyd"),
             "scikit-learn-elkan": scikit_learn("elkan"),
             "scipy-kmeans2": scipy_kmeans2,
         }
+        if "iterations_run" not in parameters:  # once per case: whether they all did the same work
+            parameters.update(_kmeans_work(implementations, iterations))
+        return implementations
 
     from solutions._fast.lloyd import _GRAIN
     from solutions.cluster import _RESUM_FRACTION
@@ -417,8 +420,22 @@ def _kmeans_case(dataset, n, k=8, iterations=30):
     # How the reference ran, for the appendix to state (the book cannot import the reference:
     # it is not in the students' repository).
     how = {"reference_resum_fraction": _RESUM_FRACTION, "reference_threads_from": 2 * _GRAIN}
+    parameters = {"k": k, "iterations": iterations, **how}
     target = (FASTEST_PEER, 1.0) if n >= 100_000 else None
-    return Case("kmeans", f"k{k}", dataset, n, make, {"k": k, "iterations": iterations, **how}, target)
+    return Case("kmeans", f"k{k}", dataset, n, make, parameters, target)
+
+
+def _kmeans_work(implementations, iterations):
+    """Each k-means implementation run once: the iterations it ran (``kmeans2`` has no stopping
+    test: all of them) and the share of its labels equal to the reference's."""
+    labels, _, _, reference_iterations = implementations["reference"]()
+    run, agree = {"reference": int(reference_iterations)}, {}
+    for name in ("scikit-learn-lloyd", "scikit-learn-elkan"):
+        fit = implementations[name]()
+        run[name], agree[name] = int(fit.n_iter_), float(np.mean(fit.labels_ == labels))
+    run["scipy-kmeans2"] = iterations
+    agree["scipy-kmeans2"] = float(np.mean(implementations["scipy-kmeans2"]()[1] == labels))
+    return {"iterations_run": run, "labels_agree_with_reference": agree}
 
 
 def _dbscan_case(dataset, n, min_samples=16):
