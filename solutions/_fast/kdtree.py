@@ -256,8 +256,9 @@ def _radius_walk(order, start, stop, axis, split, left, right, points, query, r2
 
 
 @njit(cache=True, nogil=True)
-def radius_rows(order, start, stop, axis, split, left, right, stack_size, points, queries, r2, first, last):
-    """CSR rows of ``queries[first:last]`` in one pass: (counts, indices, distances), each row sorted."""
+def radius_rows(order, start, stop, axis, split, left, right, stack_size, points, queries, rows, r2, first, last):
+    """CSR rows of ``queries[rows[first:last]]`` in one pass, in that order: (counts, indices,
+    distances), each row sorted."""
     counts = np.zeros(last - first, dtype=np.int64)
     all_i = np.empty(max(64, 16 * (last - first)), dtype=np.int64)
     all_d = np.empty(all_i.shape[0])
@@ -267,7 +268,7 @@ def radius_rows(order, start, stop, axis, split, left, right, stack_size, points
     filled = 0
     for qi in range(first, last):
         c, out_s, out_i = _radius_walk(
-            order, start, stop, axis, split, left, right, points, queries[qi], r2, stack, out_s, out_i
+            order, start, stop, axis, split, left, right, points, queries[rows[qi]], r2, stack, out_s, out_i
         )
         all_i, all_d, filled = append_row(all_i, all_d, filled, out_s, out_i, c)
         counts[qi - first] = c

@@ -173,8 +173,9 @@ def _radius_walk(order, start, stop, center, extent, children, xyz, query, r2, s
 
 
 @njit(cache=True, nogil=True)
-def radius_rows(order, start, stop, center, extent, children, stack_size, xyz, queries, r2, first, last):
-    """CSR rows of ``queries[first:last]`` in one pass: (counts, indices, distances), each row sorted."""
+def radius_rows(order, start, stop, center, extent, children, stack_size, xyz, queries, rows, r2, first, last):
+    """CSR rows of ``queries[rows[first:last]]`` in one pass, in that order: (counts, indices,
+    distances), each row sorted."""
     counts = np.zeros(last - first, dtype=np.int64)
     all_i = np.empty(max(64, 16 * (last - first)), dtype=np.int64)
     all_d = np.empty(all_i.shape[0])
@@ -184,7 +185,7 @@ def radius_rows(order, start, stop, center, extent, children, stack_size, xyz, q
     filled = 0
     for qi in range(first, last):
         c, out_s, out_i = _radius_walk(
-            order, start, stop, center, extent, children, xyz, queries[qi], r2, stack, out_s, out_i
+            order, start, stop, center, extent, children, xyz, queries[rows[qi]], r2, stack, out_s, out_i
         )
         all_i, all_d, filled = append_row(all_i, all_d, filled, out_s, out_i, c)
         counts[qi - first] = c

@@ -12,7 +12,7 @@ from numba import njit
 
 from solutions._fast.sorting import sort_pairs
 
-__all__ = ["squared_distance", "sort_row", "append_row", "unpermute_rows"]
+__all__ = ["squared_distance", "sort_row", "append_row", "place_rows"]
 
 _INSERTION_LIMIT = 48
 
@@ -60,17 +60,13 @@ def append_row(all_i, all_d, filled, s, index, count):
 
 
 @njit(cache=True, nogil=True)
-def unpermute_rows(indptr, indices, distances, permutation):
-    """CSR rows computed for ``queries[permutation]``, put back in the queries' order."""
-    counts = indptr[1:] - indptr[:-1]
-    final_counts = np.empty_like(counts)
-    final_counts[permutation] = counts
-    final_indptr = np.zeros(len(counts) + 1, dtype=np.int64)
-    final_indptr[1:] = np.cumsum(final_counts)
-    final_indices, final_distances = np.empty_like(indices), np.empty_like(distances)
-    for row in range(len(counts)):
-        source, target = indptr[row], final_indptr[permutation[row]]
-        for j in range(counts[row]):
-            final_indices[target + j] = indices[source + j]
-            final_distances[target + j] = distances[source + j]
-    return final_indptr, final_indices, final_distances
+def place_rows(counts, indices, distances, rows, indptr, out_indices, out_distances):
+    """Copy CSR rows computed for the queries ``rows`` (in that order: ``counts``, ``indices``,
+    ``distances``) to those queries' own rows of the final CSR arrays (``indptr``, ``out_*``)."""
+    source = 0
+    for j in range(rows.shape[0]):
+        target = indptr[rows[j]]
+        for m in range(counts[j]):
+            out_indices[target + m] = indices[source + m]
+            out_distances[target + m] = distances[source + m]
+        source += counts[j]

@@ -14,7 +14,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-__all__ = ["in_threads", "map_slices", "threshold", "stress_slicing", "worker_count"]
+__all__ = ["in_threads", "map_slices", "slice_bounds", "threshold", "stress_slicing", "worker_count"]
 
 # Set only by stress_slicing(): (threads, smallest slice), or None for the machine's own.
 _STRESS = None
@@ -32,7 +32,7 @@ def threshold(items):
     return items if _STRESS is None else _STRESS[1]
 
 
-def _slice_bounds(n, grain):
+def slice_bounds(n, grain):
     """``slices + 1`` int64 bounds cutting ``0..n`` into about 16 slices per thread, none under ``grain`` items.
 
     The work per item varies (a lidar scan is dense near the sensor, sparse far
@@ -46,7 +46,7 @@ def _slice_bounds(n, grain):
 
 def map_slices(kernel, n, inputs, grain=4096):
     """``[kernel(*inputs, first, last) for each slice]`` of ``0..n-1``, the slices on every core, in order."""
-    bounds = _slice_bounds(n, grain)
+    bounds = slice_bounds(n, grain)
     slices = len(bounds) - 1
     workers = worker_count()
     if slices == 1 or workers == 1:
