@@ -222,8 +222,8 @@ def gmm_em(points, weights, means, covariances, max_iter=100, tol=1e-3, reg_cova
         The average log-likelihood recorded at each iteration's E-step; it
         never decreases in exact arithmetic for ``reg_covar = 0`` and without
         the ``10 eps`` (with it, the M-step is not exactly the maximiser, and
-        the bound can fall by a second-order amount, far below rounding,
-        unless a component's weight has fallen to a few multiples of eps).
+        the bound can fall by a small amount, of second order in eps unless
+        a component is nearly empty; the Gaussian mixtures chapter bounds it).
     n_iter : int
         The number of iterations run, ``1 <= n_iter <= max_iter``.
 
