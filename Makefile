@@ -28,10 +28,12 @@ $(CODE_STAMP): $(wildcard pcl_course/*.py solutions/*.py)
 
 # numba's on-disk cache checks a kernel's own file only: a kernel that calls
 # one from another file of solutions/_fast (rows.py, say) would keep the old
-# code after that file changed. Any change there drops the whole cache.
+# code after that file changed. Any change there drops the whole cache, and the bounds-checked
+# run's (test_kernels.py) too: it kept the old code.
 NUMBA_STAMP := _build/.numba-stamp
 $(NUMBA_STAMP): $(wildcard solutions/_fast/*.py)
 	rm -f solutions/_fast/__pycache__/*.nbi solutions/_fast/__pycache__/*.nbc
+	rm -rf $(NUMBA_CHECKED_CACHE)
 	mkdir -p _build && touch $@
 
 # -W -n --keep-going: a failing cell (raise_on_error in _config.yml) or a

