@@ -330,7 +330,7 @@ def _tree_arrays(tree, name, keys, n_points):
             raise ValueError(f"{name}[{key!r}] must be a NumPy array of {np.dtype(dtype).name}")
         arrays[key] = array
     order = arrays["order"]
-    if order.shape != (n_points,) or not np.array_equal(np.sort(order), np.arange(n_points)):
+    if not _is_permutation(order, n_points):
         raise ValueError(
             f"{name}['order'] must be a permutation of the {n_points} point indices (a tree of these points)"
         )
@@ -343,13 +343,25 @@ def _tree_arrays(tree, name, keys, n_points):
     return arrays, n_nodes
 
 
+def _is_permutation(values, n):
+    """Whether the int64 array ``values`` holds each of ``0 .. n - 1`` exactly once (counted: a
+    search checks its tree at every call, and sorting a million indices took most of that check)."""
+    if values.shape != (n,):
+        return False
+    if n == 0:
+        return True
+    if values.min() < 0 or values.max() >= n:
+        return False
+    return bool(np.all(np.bincount(values, minlength=n) == 1))
+
+
 def _check_children(children, parents, n_nodes, name, key):
     """One tree rooted at node 0: every other node is the child of exactly one node with a smaller id."""
     valid = (children == -1) | ((children > parents) & (children < n_nodes))
     if not np.all(valid):
         raise ValueError(f"{name}[{key!r}] must hold node ids greater than their parent's and below M, or -1")
-    ids = children[children >= 0]
-    if len(np.unique(ids)) != len(ids) or len(ids) != n_nodes - 1:
+    ids = children[children >= 0]  # each in 1 .. M - 1 (checked above): counted, not sorted or hashed
+    if len(ids) != n_nodes - 1 or np.any(np.bincount(ids, minlength=n_nodes)[1:] != 1):
         raise ValueError(f"{name}: every node but the root must be the child of exactly one node")
 
 
