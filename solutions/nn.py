@@ -156,16 +156,36 @@ def kdtree_knn(tree, points, queries, k):
     return _knn_in_locality_order(_kdtree.knn, arrays, points, queries, k)
 
 
+def _search_order(points, queries, order):
+    """The order in which a search takes the queries: along a Z-order curve when there are many, so
+    that consecutive queries walk the same nodes, which stay in cache (the answers are the same in
+    any order); the tree's own ``order`` when the queries are its points (its leaves, one after the
+    other: as local, and already there)."""
+    n = len(queries)
+    if n < threshold(_LOCALITY_QUERIES) or queries.shape[1] < 3:
+        return np.arange(n)
+    if _same_array(points, queries):
+        return order
+    return morton_order(queries[:, :3])
+
+
+def _same_array(a, b):
+    """Whether two arrays are views of the same memory with the same layout."""
+    return (
+        a.shape == b.shape
+        and a.strides == b.strides
+        and a.dtype == b.dtype
+        and a.__array_interface__["data"][0] == b.__array_interface__["data"][0]
+    )
+
+
 def _knn_in_locality_order(kernel, arrays, points, queries, k):
     """Run a kNN kernel over every core, on the queries in Z-order when there are many.
 
     The kernel reads the queries in that order and writes each answer to its query's own row:
     neither the queries nor the answers are copied into Z-order and back (at 1e6 queries, putting
     the answers back took a sixth of the search)."""
-    if len(queries) >= threshold(_LOCALITY_QUERIES) and queries.shape[1] >= 3:
-        rows = morton_order(queries[:, :3])
-    else:
-        rows = np.arange(len(queries))
+    rows = _search_order(points, queries, arrays[0])
     indices = np.empty((len(queries), k), dtype=np.int64)
     distances = np.empty((len(queries), k))
     in_threads(kernel, len(queries), (*arrays, points, queries, rows, k), (indices, distances), grain=_QUERY_GRAIN)
@@ -181,8 +201,7 @@ def _csr_in_locality_order(rows_kernel, arrays, points, queries, r2):
     (a concatenation of the slices, then a permutation of the rows, was a quarter of the search
     at 1e5 queries of 25 neighbours)."""
     n = len(queries)
-    rows = morton_order(queries[:, :3]) if n >= threshold(_LOCALITY_QUERIES) and queries.shape[1] >= 3 else None
-    rows = np.arange(n) if rows is None else rows
+    rows = _search_order(points, queries, arrays[0])
     parts = map_slices(rows_kernel, n, (*arrays, points, queries, rows, r2), grain=_QUERY_GRAIN)
     counts = np.empty(n, dtype=np.int64)
     counts[rows] = np.concatenate([part[0] for part in parts])
