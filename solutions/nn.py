@@ -27,8 +27,8 @@ from solutions._fast.order import morton_order
 from solutions._fast.rows import place_rows
 from solutions._fast.threads import in_threads, map_slices, slice_bounds, threshold, worker_count
 
-# Above this many queries, kNN visits them along a Z-order curve: consecutive queries then
-# walk the same nodes, which stay in cache (the answers are the same in any order).
+# Above this many queries, a search takes them in an order that keeps neighbours together
+# (_search_order): consecutive queries then walk the same nodes, which stay in cache.
 _LOCALITY_QUERIES = 20_000
 # Queries per slice of a search on every core.
 _QUERY_GRAIN = 1024
