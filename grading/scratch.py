@@ -10,8 +10,8 @@ that.
 """
 
 import os
-import shutil
 import stat
+import subprocess
 import tempfile
 import time
 
@@ -53,10 +53,23 @@ def folder(prefix):
 def remove(path):
     """Remove a folder made by :func:`folder`, and release its lock."""
     path = str(path)
-    shutil.rmtree(path, ignore_errors=True)
-    descriptor = _held.pop(path, None)
-    if descriptor is not None:
-        os.close(descriptor)
+    try:
+        remove_tree(path)
+    finally:
+        descriptor = _held.pop(path, None)
+        if descriptor is not None:
+            os.close(descriptor)
+
+
+def remove_tree(path):
+    """Remove the folder ``path`` and everything in it, links not followed, however deep.
+
+    Not ``shutil.rmtree``: before Python 3.12 it recurses once per level, and a submission's
+    home nested a few thousand folders deep made it raise RecursionError (past ignore_errors),
+    which left the folder, and then every later grading's sweep broke on it. ``rm -rf`` walks
+    iteratively; what it cannot remove is left, and a later sweep tries again.
+    """
+    subprocess.run(["rm", "-rf", "--", str(path)], stdin=subprocess.DEVNULL, capture_output=True, check=False)
 
 
 def sweep(directory=None):
@@ -79,7 +92,7 @@ def sweep(directory=None):
         if not entry.name.startswith(PREFIXES) or not entry.is_dir(follow_symlinks=False):
             continue
         if _abandoned(entry):
-            shutil.rmtree(entry.path, ignore_errors=True)
+            remove_tree(entry.path)
             removed += 1
     return removed
 
@@ -88,13 +101,16 @@ def _abandoned(entry):
     lock = os.path.join(entry.path, LOCK)
     try:
         folder = entry.stat(follow_symlinks=False)
+    except OSError:
+        return False
+    if folder.st_uid != os.geteuid():
+        return False  # another user's: theirs to sweep
+    try:
         found = os.lstat(lock)
     except FileNotFoundError:
         return time.time() - folder.st_mtime > UNLOCKED_AGE
     except OSError:
         return False
-    if folder.st_uid != os.geteuid():
-        return False  # another user's: theirs to sweep
     if not stat.S_ISREG(found.st_mode) or found.st_uid != os.geteuid():
         # Not a lock this user made (folder() makes a regular file of its own): nobody can
         # hold it, so it is treated as a missing lock, and the folder is swept once old.

@@ -175,12 +175,12 @@ class Worker:
                 if not self._leftovers():
                     break
                 time.sleep(0.01)
-        if self.work:
-            scratch.remove(self.work)
-            self.work = None
-        if self.exchange is not None:
-            os.close(self.exchange)
-            self.exchange = None
+        work, self.work = self.work, None
+        exchange, self.exchange = self.exchange, None
+        if exchange is not None:
+            os.close(exchange)
+        if work:
+            scratch.remove(work)
 
     def close(self):
         """Stop the worker and remove every file its uids left anywhere writable."""

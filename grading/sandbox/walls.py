@@ -54,6 +54,7 @@ from grading.sandbox.bubblewrap import (
     spawn,
 )
 from grading.sandbox.processes import become_subreaper, kill_uid, preexec
+from grading.scratch import remove_tree
 
 PROTECTED = ("tests", "solutions", ".git")  # of the course copy: never readable by a submission
 # Folders of the grading's own (the platform's: Gradescope's /autograder, with its
@@ -260,7 +261,7 @@ def remove_files_of(uid, roots=WRITABLE_ROOTS):
     """
     for path, info in list(files_of(uid, roots)):
         if stat.S_ISDIR(info.st_mode):
-            shutil.rmtree(path, ignore_errors=True)
+            remove_tree(path)  # however deep the uid nested it (shutil.rmtree recursed)
         else:
             try:
                 os.unlink(path)

@@ -126,3 +126,31 @@ def test_a_worker_cannot_unlock_the_folder_that_holds_its_home(tmp_path):
         assert scratch.sweep(os.path.dirname(worker.work)) == 0 and os.path.isdir(worker.home)
     finally:
         worker.stop()
+
+
+def test_a_tree_nested_past_pythons_recursion_is_removed_and_swept(tmp_path):
+    """A home nested thousands of folders deep (a submission can make one in its import) made
+    shutil.rmtree raise RecursionError: the folder stayed, and every later sweep broke on it."""
+    deep = tmp_path / "grading-home-deep"
+    deep.mkdir()
+    descriptor = os.open(deep, os.O_RDONLY)
+    for _ in range(3000):  # by descriptor: the path itself would pass the length limit
+        os.mkdir("d", dir_fd=descriptor)
+        inner = os.open("d", os.O_RDONLY, dir_fd=descriptor)
+        os.close(descriptor)
+        descriptor = inner
+    os.close(descriptor)
+    hour_ago = time.time() - scratch.UNLOCKED_AGE - 60
+    os.utime(deep, (hour_ago, hour_ago))
+    assert scratch.sweep(tmp_path) == 1 and not deep.exists()
+
+
+def test_another_users_lockless_folder_is_not_swept(tmp_path):
+    if os.geteuid() != 0:
+        pytest.skip("making a folder of another user needs root")
+    theirs = tmp_path / "grading-home-theirs"
+    theirs.mkdir()
+    os.chown(theirs, 65534, 65534)
+    hour_ago = time.time() - scratch.UNLOCKED_AGE - 60
+    os.utime(theirs, (hour_ago, hour_ago))
+    assert scratch.sweep(tmp_path) == 0 and theirs.is_dir()
