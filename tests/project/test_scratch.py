@@ -142,7 +142,10 @@ def test_a_tree_nested_past_pythons_recursion_is_removed_and_swept(tmp_path):
     os.close(descriptor)
     hour_ago = time.time() - scratch.UNLOCKED_AGE - 60
     os.utime(deep, (hour_ago, hour_ago))
-    assert scratch.sweep(tmp_path) == 1 and not deep.exists()
+    try:
+        assert scratch.sweep(tmp_path) == 1 and not deep.exists()
+    finally:  # never left for pytest's own clean-up of old runs (shutil.rmtree: RecursionError)
+        scratch.remove_tree(deep)
 
 
 def test_another_users_lockless_folder_is_not_swept(tmp_path):
