@@ -10,6 +10,7 @@ that.
 """
 
 import os
+import shutil
 import stat
 import subprocess
 import tempfile
@@ -64,12 +65,15 @@ def remove(path):
 def remove_tree(path):
     """Remove the folder ``path`` and everything in it, links not followed, however deep.
 
-    Not ``shutil.rmtree``: before Python 3.12 it recurses once per level, and a submission's
+    ``shutil.rmtree``, and ``rm -rf`` where it fails: before Python 3.12 it recurses once per level, and a submission's
     home nested a few thousand folders deep made it raise RecursionError (past ignore_errors),
-    which left the folder, and then every later grading's sweep broke on it. ``rm -rf`` walks
-    iteratively; what it cannot remove is left, and a later sweep tries again.
+    which left the folder, and then every later grading's sweep broke on it. Such a tree goes to
+    ``rm -rf``, which walks iteratively; what it cannot remove is left for a later sweep.
     """
-    subprocess.run(["rm", "-rf", "--", str(path)], stdin=subprocess.DEVNULL, capture_output=True, check=False)
+    try:
+        shutil.rmtree(path, ignore_errors=True)
+    except RecursionError:  # only for such trees: a process per removal would cost every grading
+        subprocess.run(["rm", "-rf", "--", str(path)], stdin=subprocess.DEVNULL, capture_output=True, check=False)
 
 
 def sweep(directory=None):
