@@ -326,8 +326,10 @@ def _tree_arrays(tree, name, keys, n_points):
     for key, kind in keys.items():
         array = tree[key]
         dtype = np.int64 if kind == "i" else np.float64
-        if not isinstance(array, np.ndarray) or array.dtype != dtype:
-            raise ValueError(f"{name}[{key!r}] must be a NumPy array of {np.dtype(dtype).name}")
+        # Exactly an ndarray: a subclass may change what the checks below see (a masked
+        # array's np.any skips its masked entries), and the kernels read the raw data.
+        if type(array) is not np.ndarray or array.dtype != dtype:
+            raise ValueError(f"{name}[{key!r}] must be a NumPy array (not a subclass) of {np.dtype(dtype).name}")
         arrays[key] = array
     order = arrays["order"]
     if not _is_permutation(order, n_points):

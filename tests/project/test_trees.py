@@ -120,3 +120,15 @@ def test_the_unguarded_value_split_is_the_students_build_and_endless_only_on_poi
     ):
         with pytest.raises(RecursionError):
             build()
+
+
+def test_a_tree_of_array_subclasses_is_refused_before_a_search_reads_it(rng):
+    """A masked array hides entries from the checks (np.any skips them) but not from the kernels,
+    which read the raw data: a start of -1000 masked passed the range check."""
+    points = rng.uniform(size=(200, 3))
+    for build, search in ((nn.kdtree_build, nn.kdtree_knn), (nn.octree_build, nn.octree_knn)):
+        tree = build(points, 8)
+        start = np.ma.masked_array(tree["start"].copy(), mask=np.zeros(len(tree["start"]), bool))
+        start[1], start.mask[1] = -1000, True
+        with pytest.raises(ValueError, match=r"\['start'\] must be a NumPy array \(not a subclass\)"):
+            search({**tree, "start": start}, points, points[:3], 2)
