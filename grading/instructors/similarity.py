@@ -18,13 +18,22 @@ Each entry of the class folder is read as ``batch`` and Gradescope read it
 ``pcl_course/``, loose modules, a nested folder; regular files only, no
 link followed), so a link in a submission never puts another file's text
 into the report, and each module is decoded as Python decodes it (a PEP 263
-coding line honoured). Every entry or module not compared is listed, with why.
+coding line honoured). The grader runs every file of the package, so a copy
+may sit in any of them (a helper module of the student's own, or another
+exercise module the first imports): each student's module is also compared
+with the other student's whole package (every ``.py`` file that is not the
+course's own), and that pair is kept where it finds more. Code a module
+builds while it runs (``exec``, ``eval``, ``compile``: a copy compressed into
+one string literal) cannot be compared: each such call is listed, to be read
+by hand. Every entry or file not compared is listed, with why (one over
+:data:`REPORT_FILE_LIMIT` characters, among them).
 Students' folder names are shown escaped (:func:`grading.results.clean`). The report is one self-contained
 HTML page (no script, no web font, no stylesheet fetched): the pairs ranked
 by similarity, each with both files side by side and the shared code
 highlighted. A high score is a reason to read the two files, not a verdict.
 """
 
+import ast
 import html
 import io
 import itertools
@@ -58,6 +67,15 @@ COMMON_MIN_STUDENTS = 3
 FAMILY_SHARE = 0.8
 DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
+# Characters of one file the report compares and shows: the reference's longest module has 27,000;
+# a student's 3.5 MB file took a 3-student report 3.5 minutes and 8 MB of HTML (h72).
+REPORT_FILE_LIMIT = 200_000
+# A module compared with the other's whole package is kept when a share of its fingerprints larger than
+# the module-to-module pair's by this much is there (a cheap count first; the highlighting only then).
+PACKAGE_MARGIN = 0.1
+PACKAGE_VIEW = "found in the other's package"
+FILE_HEADER = "# ==== {} ====\n"  # before each file of a package's text
+RUNTIME_CODE = frozenset({"exec", "eval", "compile"})  # calls whose code is built while the module runs
 # Each pair is compared twice, the higher share kept: as Python reads the files (what does nothing
 # removed: a padding between the lines of a copy is gone) and as submitted (only the texts that are no
 # code removed: whatever the normaliser mistook for dead code is there). Normalising can then only
@@ -85,6 +103,11 @@ class Pair:
     first_html: str
     second_html: str
     view: str = next(iter(VIEWS))
+    second_where: str = ""  # where the second's code is: its own module's file unless said
+
+    @property
+    def second_file(self):
+        return self.second_where or f"{self.module}.py"
 
     @property
     def similarity(self):
@@ -151,25 +174,87 @@ def _common_line(module, common):
     )
 
 
-def _module_text(package, module):
-    """The text of ``module`` in a laid-over ``package``, decoded as Python decodes it (or a SyntaxError)."""
-    inside = package / module / "__init__.py"
-    return read_source(inside if inside.is_file() else package / f"{module}.py")
+@dataclass(frozen=True)
+class Submitted:
+    """One student's code as the report reads it: ``modules``, each exercise module's text (a module
+    written as a package: its files together), and ``package``, every ``.py`` file of the package that
+    is not the course's own, by its path in the package."""
+
+    modules: dict
+    package: dict  # relative path -> text
 
 
-def _student_modules(class_dir, into):
-    """Read each entry as grading does; return ({student: {module: text}}, lines on what was not compared).
+def _package_text(files, prepare):
+    """One text of a package's ``files``, each prepared alone (a file's names are its own) after its header."""
+    return "".join(FILE_HEADER.format(relative) + prepare(text) for relative, text in files.items())
+
+
+def _runtime_code(text):
+    """The lines of the calls of ``exec``, ``eval`` or ``compile`` (by name or ``builtins.``) in ``text``."""
+    try:
+        tree = ast.parse(text)
+    except (SyntaxError, ValueError):
+        return []
+    lines = []
+    for node in ast.walk(tree):
+        if not isinstance(node, ast.Call):
+            continue
+        func = node.func
+        name = func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else None
+        if name in RUNTIME_CODE and (isinstance(func, ast.Name) or _dotted_root(func) == "builtins"):
+            lines.append((node.lineno, name))
+    return sorted(lines)
+
+
+def _dotted_root(node):
+    while isinstance(node, ast.Attribute):
+        node = node.value
+    return node.id if isinstance(node, ast.Name) else None
+
+
+def _read_package(package, name, stubs):
+    """({relative path: text} of every ``.py`` file of ``package`` that is not the stubs' own, lines on
+    what was not read): decoded as Python decodes it, each under :data:`REPORT_FILE_LIMIT` characters."""
+    texts, lines = {}, []
+    for path in sorted(package.rglob("*.py")):
+        relative = path.relative_to(package).as_posix()
+        course = Path(stubs) / relative
+        if path.is_symlink() or not path.is_file():
+            continue  # the laid-over copy holds regular files only
+        if course.is_file() and course.read_bytes() == path.read_bytes():
+            continue
+        try:
+            text = read_source(path)
+        except (SyntaxError, OSError) as exc:
+            reason = exc.msg if isinstance(exc, SyntaxError) else exc.strerror
+            lines.append(f"{name}: {relative} not compared: {reason}")
+            continue
+        if len(text) > REPORT_FILE_LIMIT:
+            lines.append(
+                f"{name}: {relative} not compared: {len(text):,} characters, over the report's {REPORT_FILE_LIMIT:,}"
+            )
+            continue
+        calls = _runtime_code(text)
+        if calls:
+            where = ", ".join(f"{call} at line {line}" for line, call in calls[:5])
+            lines.append(f"{name}: {relative} runs code it builds while it runs ({where}): that code is not compared")
+        texts[relative] = text
+    return texts, lines
+
+
+def _student_modules(class_dir, into, stubs=REPO_ROOT / "pcl_course"):
+    """Read each entry as grading does; return ({student: :class:`Submitted`}, lines on what was not compared).
 
     Every entry of the class folder (as ``batch`` lists them:
     :func:`grading.instructors.batch.class_folders`) is laid over the stubs
     as ``batch`` and Gradescope lay it (:func:`grading.instructors.gradescope.lay_over_stubs`:
     a clone, its ``pcl_course/``, loose modules, a nested folder), so that
-    every layout graded is compared. Each module the submission holds is
+    every layout graded is compared. Each file the submission holds is
     decoded as the interpreter decodes it (:func:`grading.forbidden.read_source`:
     a PEP 263 coding line such as ``utf-7`` is honoured); one Python would
     not decode is not compared, with a line that says so.
     """
-    modules, skipped = {}, []
+    students, skipped = {}, []
     for position, entry in enumerate(class_folders(Path(class_dir))):
         name = entry.name
         if entry.is_symlink() or not entry.is_dir():
@@ -180,26 +265,29 @@ def _student_modules(class_dir, into):
         except StagingError as exc:
             skipped.append(f"{name}: not compared: {exc}")
             continue
-        texts = {}
+        files, lines = _read_package(assembled.package, name, stubs)
+        skipped += lines
+        modules = {}
         for module in assembled.found:
-            try:
-                texts[module] = _module_text(assembled.package, module)
-            except (SyntaxError, OSError) as exc:
-                reason = exc.msg if isinstance(exc, SyntaxError) else exc.strerror
-                skipped.append(f"{name}: {module}.py not compared: {reason}")
-                continue
-            if (assembled.package / module).is_dir():
-                skipped.append(f"{name}: {module}/ is a package: only its __init__.py compared")
-        modules[name] = texts
-    return modules, skipped
+            own = [text for relative, text in files.items() if relative.split("/")[0] in (module, f"{module}.py")]
+            if own:
+                modules[module] = "\n".join(own)
+        students[name] = Submitted(modules, files)
+    return students, skipped
 
 
-def _compared(module, first, second, view, fingerprints):
-    """The :class:`Pair` of two students' versions in one view, or None if they share no code."""
-    a, b = fingerprints[first], fingerprints[second]
+def _compared(module, first, second, view, fingerprints, other=None):
+    """The :class:`Pair` of two students' versions in one view, or None if they share no code.
+
+    With ``other`` (the second's package fingerprint), the first's module is compared with it: the
+    second's side then shows only the files that share code."""
+    a, b = fingerprints[first], other if other is not None else fingerprints[second]
     tokens, (share_a, share_b), (slices_a, slices_b) = compare_files(a, b)
     if tokens == 0:
         return None
+    second_html = highlight_overlap(b.raw_code, slices_b, *HIGHLIGHT, escape_html=True)[0]
+    if other is not None:
+        second_html = _files_sharing_code(second_html)
     return Pair(
         module,
         first,
@@ -208,9 +296,39 @@ def _compared(module, first, second, view, fingerprints):
         float(share_b),
         int(tokens),
         highlight_overlap(a.raw_code, slices_a, *HIGHLIGHT, escape_html=True)[0],
-        highlight_overlap(b.raw_code, slices_b, *HIGHLIGHT, escape_html=True)[0],
-        view,
+        second_html,
+        PACKAGE_VIEW if other is not None else view,
+        "the package" if other is not None else "",
     )
+
+
+def _files_sharing_code(highlighted):
+    """A highlighted package text cut to its files (after their :data:`FILE_HEADER`) that hold a mark."""
+    marker = html.escape(FILE_HEADER.split("{}")[0])
+    pieces = highlighted.split(marker)
+    return "".join(marker + piece for piece in pieces[1:] if HIGHLIGHT[0] in piece) or highlighted
+
+
+def _hash_share(hashes, others):
+    """The share of the fingerprints ``hashes`` (a set) found in ``others``: a cheap bound's stand-in."""
+    return len(hashes & others) / len(hashes) if hashes else 0.0
+
+
+def _package_pairs(module, view, module_prints, package_prints, best):
+    """Each student's ``module`` compared with each other student's package in one ``view``: into
+    ``best`` (the pairs so far, by their two names sorted) goes each pair that finds a larger share."""
+    own = {student: set(f.hashes) for student, f in module_prints.items()}
+    packages = {student: set(f.hashes) for student, f in package_prints.items()}
+    for first, second in itertools.permutations(sorted(own), 2):
+        if second not in packages:
+            continue
+        key = tuple(sorted((first, second)))
+        known = best[key].similarity if key in best else 0.0
+        if _hash_share(own[first], packages[second]) <= known + PACKAGE_MARGIN:
+            continue
+        pair = _compared(module, first, second, view, module_prints, package_prints[second])
+        if pair is not None and pair.first_share > known:
+            best[key] = pair
 
 
 def submitted_by(folder, submitters=None):
@@ -244,26 +362,35 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     boilerplate = {view: _boilerplate_hashes(stubs, prepare) for view, prepare in VIEWS.items()}
     work = tempfile.mkdtemp(prefix="grading-similarity-")
     try:
-        modules, skipped = _student_modules(class_dir, work)
+        submitted, skipped = _student_modules(class_dir, work, stubs)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     people, problems = read_gradescope_metadata(Path(class_dir))
     skipped = problems + skipped
-    modules = {submitted_by(folder, people.get(folder)): files for folder, files in modules.items()}
-    pairs = []
+    submitted = {submitted_by(folder, people.get(folder)): files for folder, files in submitted.items()}
+    pairs, module_prints, left_out = {}, {}, {view: [boilerplate[view]] for view in VIEWS}
     for module in EXERCISE_MODULES:
-        texts = {student: files[module] for student, files in modules.items() if module in files}
-        fingerprints = {}
+        texts = {student: files.modules[module] for student, files in submitted.items() if module in files.modules}
+        module_prints[module], pairs[module] = {}, {}
         for view, prepare in VIEWS.items():
-            left_out, common = _common_hashes(module, texts, boilerplate[view], prepare)
-            fingerprints[view] = _fingerprints(module, texts, left_out, prepare)
+            module_left_out, common = _common_hashes(module, texts, boilerplate[view], prepare)
+            left_out[view].append(module_left_out)
+            module_prints[module][view] = _fingerprints(module, texts, module_left_out, prepare)
             if prepare is comparable:
                 skipped += [line for line in [_common_line(module, common)] if line]
         for first, second in itertools.combinations(sorted(texts), 2):
-            compared = [_compared(module, first, second, view, fingerprints[view]) for view in VIEWS]
+            compared = [_compared(module, first, second, view, module_prints[module][view]) for view in VIEWS]
             compared = [pair for pair in compared if pair is not None]
-            if compared:
-                pairs.append(max(compared, key=lambda pair: pair.similarity))  # the first view on a tie
+            if compared:  # the first view on a tie
+                pairs[module][first, second] = max(compared, key=lambda pair: pair.similarity)
+    # A copy kept in another file of the package: what is common in any module is left out of the packages.
+    packages = {student: files.package for student, files in submitted.items() if files.package}
+    for view, prepare in VIEWS.items():
+        texts = {student: _package_text(files, prepare) for student, files in packages.items()}
+        package_prints = _fingerprints("package", texts, np.unique(np.concatenate(left_out[view])), str)
+        for module in EXERCISE_MODULES:
+            _package_pairs(module, view, module_prints[module][view], package_prints, pairs[module])
+    pairs = [pair for found in pairs.values() for pair in found.values()]
     pairs.sort(key=lambda pair: (-pair.similarity, pair.module, pair.first, pair.second))
     return pairs, skipped
 
@@ -310,9 +437,9 @@ def render_report(pairs, skipped, threshold=DISPLAY_THRESHOLD, top=100):
     sections = "\n".join(
         f'<section class="pair" id="pair-{i}"><h2>{i}. {html.escape(p.module)}.py: '
         f"{_text(p.first)} and {_text(p.second)} ({p.similarity:.0%}, {html.escape(p.view)})</h2>"
-        f'<div class="sides"><div><h3>{_text(p.first)} ({p.first_share:.0%} shared)</h3>'
+        f'<div class="sides"><div><h3>{_text(p.first)}, {html.escape(p.module)}.py ({p.first_share:.0%} shared)</h3>'
         f"<pre>{_code(p.first_html)}</pre></div>"
-        f"<div><h3>{_text(p.second)} ({p.second_share:.0%} shared)</h3>"
+        f"<div><h3>{_text(p.second)}, {html.escape(p.second_file)} ({p.second_share:.0%} shared)</h3>"
         f"<pre>{_code(p.second_html)}</pre></div></div></section>"
         for i, p in enumerate(shown, start=1)
     )

@@ -290,7 +290,7 @@ def test_every_layout_graded_is_compared_as_python_decodes_it_and_every_entry_le
     (erin / "pca.py").write_bytes(("# caf\u00e9\n" + pca_source(DAVE)).encode("latin-1"))
     (tmp_path / "frank.txt").write_text("not a submission")
     (tmp_path / "gina").mkdir()  # an empty upload
-    ivan = student(tmp_path, "ivan")  # pca written as a package: its __init__.py only is compared
+    ivan = student(tmp_path, "ivan")  # pca written as a package: its files are compared together
     (ivan / "pca.py").rename(ivan / "pca_init.py")
     (ivan / "pca").mkdir()
     (ivan / "pca_init.py").rename(ivan / "pca" / "__init__.py")
@@ -300,11 +300,10 @@ def test_every_layout_graded_is_compared_as_python_decodes_it_and_every_entry_le
     assert min(found.values()) > 0.9, (found, similarity, skipped)
     copies = {("alice", "bob"), ("carol", "dave")}
     assert all(s < DISPLAY_THRESHOLD for key, s in similarity.items() if key[1:] not in copies), similarity
-    assert len(skipped) == 5 and skipped[4].startswith("pca.py: "), skipped  # the code all write alike, left out
+    assert len(skipped) == 4 and skipped[3].startswith("pca.py: "), skipped  # the code all write alike, left out
     assert skipped[0].startswith("erin: pca.py not compared: its bytes cannot be decoded as Python decodes them")
     assert skipped[1] == "frank.txt: not compared: not a folder (a link or a file)"
     assert skipped[2].startswith("gina: not compared: nothing to grade (expected pca.py, ")
-    assert skipped[3] == "ivan: pca/ is a package: only its __init__.py compared"
 
 
 def test_the_report_shows_students_control_characters_escaped():
@@ -411,3 +410,55 @@ def test_prose_two_students_pasted_raises_no_pair(prose, tmp_path):
         student(tmp_path, name, body)
     pairs, _ = compare_class(tmp_path)
     assert all(p.similarity < DISPLAY_THRESHOLD for p in pairs), [(p.first, p.second, p.similarity) for p in pairs]
+
+
+def test_a_copy_moved_into_another_file_of_the_package_is_compared(tmp_path):
+    """A hostile review (h72): the grader runs every file of the package, the report read only pca.py,
+    so a copy kept in a helper module of the student's own (or in another exercise module, imported
+    from pca.py) kept full marks and left the report. Each module is now compared with the other's
+    package too; the pane shows the files that share code."""
+    from grading.instructors.similarity import PACKAGE_VIEW, render_report
+
+    student(tmp_path, "alice", ALICE)
+    bob = student(tmp_path, "bob")
+    (bob / "impl_helpers.py").write_text(pca_source(ALICE))
+    (bob / "pca.py").write_text("from pcl_course.impl_helpers import pca  # noqa: F401\n")
+    carol = student(tmp_path, "carol")  # alice's pca at the end of carol's own cluster.py
+    (carol / "cluster.py").write_text((carol / "cluster.py").read_text() + pca_source(ALICE).split("\n\n", 1)[1])
+    (carol / "pca.py").write_text("from pcl_course.cluster import pca  # noqa: F401\n")
+    student(tmp_path, "dave", DAVE)
+    student(tmp_path, "erin", CAROL)
+    pairs, skipped = compare_class(tmp_path)
+    by_names = {(p.module, p.first, p.second): p for p in pairs}
+    for copier, where in (("bob", "impl_helpers.py"), ("carol", "cluster.py")):
+        pair = by_names.get(("pca", "alice", copier))
+        assert pair is not None and pair.similarity > 0.8 and pair.view == PACKAGE_VIEW, (copier, pair)
+        assert f"==== {where} ====" in pair.second_html and "==== pca.py" not in pair.second_html
+    copies = {"alice", "bob", "carol"}
+    others = [p for p in pairs if not {p.first, p.second} <= copies]
+    assert all(p.similarity < DISPLAY_THRESHOLD for p in others), [(p.first, p.second, p.similarity) for p in others]
+    page = render_report(pairs, skipped)
+    assert "bob, the package" in page and "alice, pca.py" in page
+
+
+def test_code_built_while_a_module_runs_is_listed_and_a_huge_file_is_not_compared(tmp_path, monkeypatch):
+    """A hostile review (h72): a copy inside exec(zlib.decompress(base64...)) folds to one string literal
+    and matched nothing; a 3.5 MB file took a 3-student report 3.5 minutes. The first is listed to be
+    read by hand, the second left out with its size."""
+    import zlib
+
+    from grading.instructors import similarity
+
+    monkeypatch.setattr(similarity, "REPORT_FILE_LIMIT", 20_000)
+    student(tmp_path, "alice", ALICE)
+    packed = base64.b64encode(zlib.compress(textwrap.dedent(ALICE).encode())).decode()
+    bob = student(tmp_path, "bob")
+    (bob / "pca.py").write_text(
+        f"import base64, zlib\nexec(zlib.decompress(base64.b64decode({packed!r})))\nimport builtins\n"
+        "builtins.eval('1')\n"
+    )
+    carol = student(tmp_path, "carol", CAROL)
+    (carol / "notes.py").write_text("X = 1\n" * 4_000)  # 24,000 characters
+    pairs, skipped = compare_class(tmp_path)
+    assert "bob: pca.py runs code it builds while it runs (exec at line 2, eval at line 4): " in "\n".join(skipped)
+    assert "carol: notes.py not compared: 24,000 characters, over the report's 20,000" in skipped
