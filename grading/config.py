@@ -123,6 +123,11 @@ CALL_MEMORY_LIMIT = MEMORY_LIMIT  # bytes of memory of all its processes togethe
 # Bytes of the files a dedicated sandbox uid may own in the places it can write (its home,
 # /tmp, /dev/shm, ...): the uid mode's counterpart of bubblewrap's TMP_SIZE + SHM_SIZE.
 DISK_LIMIT = TMP_SIZE + SHM_SIZE
+# Entries (files, folders, links) it may own there, and how deep its own folders may nest: no
+# test needs more than a few (a numba cache), and the walk that sums them stops past these,
+# so that a tree of empty files or of folders nested past PATH_MAX costs the grader little.
+FILES_LIMIT = 10_000
+FOLDER_DEPTH_LIMIT = 64
 # What the grader reads from a worker, every size checked before anything is allocated
 # (grading/sandbox/): the grader's own memory stays bounded whatever a worker sends.
 ANSWER_LIMIT = 16 * 1024**2  # bytes of all the arrays of one answer (the reference's largest: 95 kB)

@@ -3,12 +3,14 @@ as a dedicated uid, disk, read while the call runs by :class:`grading.sandbox.cl
 
 import os
 import signal
+import stat
 import time
+from dataclasses import dataclass
 
 from grading import config
 from grading.errors import SandboxError
 from grading.sandbox.processes import ticks_since_boot, unlisted_bytes, usage_of
-from grading.sandbox.walls import BUBBLEWRAP, WRITABLE_ROOTS, files_of
+from grading.sandbox.walls import BUBBLEWRAP, WORLD_WRITABLE_DEPTH, WRITABLE_ROOTS
 
 TIMEOUT, DIED = SandboxError.TIMEOUT, SandboxError.DIED
 
@@ -82,18 +84,26 @@ class CallUsage:
 
     def check_disk(self):
         """As a dedicated uid without bubblewrap (whose tmpfs are capped): stop the call if the
-        files the uid owns where it can write exceed :data:`config.DISK_LIMIT`. Read at most every
-        :data:`DISK_POLL_SECONDS` (a walk of those folders), whether the calls are long or short."""
+        files the uid owns where it can write are past a limit of :data:`FILES_LIMITS` (bytes,
+        entries, nesting). Read at most every :data:`DISK_POLL_SECONDS` (a walk of those
+        folders), whether the calls are long or short."""
         uid = self.worker.uid
         if uid is None or self.worker.isolation.level == BUBBLEWRAP:
             return
         now = time.monotonic()
         if now - _DISK_CHECKED.get(uid, 0.0) < DISK_POLL_SECONDS:
             return
-        written = disk_usage_of(uid, (*WRITABLE_ROOTS, self.worker.work))
+        limits = files_limits()
+        found = files_usage_of(uid, (*WRITABLE_ROOTS, self.worker.work), limits)
         _DISK_CHECKED[uid] = time.monotonic()
-        if written > config.DISK_LIMIT:
-            message = f"the submission wrote more than {_size(config.DISK_LIMIT)} of files"
+        message = None
+        if found.bytes > limits.bytes:
+            message = f"the submission wrote more than {_size(limits.bytes)} of files"
+        elif found.entries > limits.entries:
+            message = f"the submission made more than {limits.entries} files and folders"
+        elif found.depth > limits.depth:
+            message = f"the submission nested folders more than {limits.depth} deep"
+        if message is not None:
             self._stop(self.worker._call_processes(), message, DIED)
 
     def _stop(self, rows, message, kind):
@@ -118,7 +128,96 @@ def _size(count):
     return f"{count} bytes"
 
 
-def disk_usage_of(uid, roots):
-    """Bytes of the files ``uid`` owns below ``roots`` (allocated blocks: a sparse file counts
-    what it holds), found as :func:`grading.sandbox.walls.remove_files_of` finds them."""
-    return sum(info.st_blocks * 512 for _, info in files_of(uid, roots, into_own=True))
+@dataclass(frozen=True)
+class FilesUsage:
+    """What a uid owns where it can write, or the limits of it: ``bytes`` of allocated blocks (a
+    sparse file counts what it holds), ``entries`` (files, folders, links, ...) and ``depth``,
+    the deepest nesting of its own folders."""
+
+    bytes: int = 0
+    entries: int = 0
+    depth: int = 0
+
+    def past(self, limits):
+        return self.bytes > limits.bytes or self.entries > limits.entries or self.depth > limits.depth
+
+
+def files_limits():
+    """The :class:`FilesUsage` a dedicated uid may reach (read from :mod:`grading.config` when asked)."""
+    return FilesUsage(config.DISK_LIMIT, config.FILES_LIMIT, config.FOLDER_DEPTH_LIMIT)
+
+
+_FOLDER = os.O_RDONLY | os.O_DIRECTORY | os.O_NOFOLLOW | os.O_CLOEXEC
+
+
+def files_usage_of(uid, roots, limits=None):
+    """The :class:`FilesUsage` of the entries ``uid`` owns below ``roots``, found where
+    :func:`grading.sandbox.walls.files_of` finds them, and whole below its own folders.
+
+    Walked by file descriptors (``openat``, links never followed), not by path strings: a
+    file below a path longer than ``PATH_MAX`` counts like any other (a walk by paths skipped
+    what it could not name, and 1,000 MB went uncounted that way). The walk holds two
+    descriptors per level of the folder it is in; with ``limits``, it stops as soon as a count
+    is past its limit, so that its cost and its descriptors are bounded by them whatever the
+    uid made (300,000 empty files, or folders nested 10,000 deep).
+    """
+    used = FilesUsage()
+    for root in roots:
+        if not root:
+            continue
+        try:
+            top = os.open(root, _FOLDER)
+        except OSError:
+            continue
+        used = _walk(uid, top, used, limits)
+        if limits is not None and used.past(limits):
+            break
+    return used
+
+
+def _walk(uid, top, used, limits):
+    """Add to ``used`` the entries below the open folder ``top`` (closed here) that ``uid`` owns."""
+    total, entries, deepest = used.bytes, used.entries, used.depth
+    most = limits if limits is not None else FilesUsage(float("inf"), float("inf"), float("inf"))
+    frames = []  # (descriptor, its listing, depth, depth of the uid's own folders)
+    try:
+        frames.append((top, os.scandir(top), 0, 0))
+        while frames:
+            folder, listing, depth, own_depth = frames[-1]
+            entry = next(listing, None)
+            if entry is None:
+                frames.pop()
+                listing.close()
+                os.close(folder)
+                continue
+            try:
+                info = entry.stat(follow_symlinks=False)
+            except OSError:
+                continue
+            owned, folder_entry = info.st_uid == uid, stat.S_ISDIR(info.st_mode)
+            if owned:
+                total, entries = total + info.st_blocks * 512, entries + 1
+                deepest = max(deepest, own_depth + folder_entry)
+                if total > most.bytes or entries > most.entries or deepest > most.depth:
+                    break
+            if not folder_entry:
+                continue
+            if owned:
+                child_own_depth = own_depth + 1
+            elif own_depth == 0 and info.st_mode & stat.S_IWOTH and depth < WORLD_WRITABLE_DEPTH:
+                child_own_depth = 0
+            else:
+                continue
+            try:
+                child = os.open(entry.name, _FOLDER, dir_fd=folder)
+            except OSError:  # gone, or made a link since it was listed
+                continue
+            try:
+                frames.append((child, os.scandir(child), depth + 1, child_own_depth))
+            except OSError:
+                os.close(child)
+    finally:
+        for folder, listing, _, _ in frames:
+            listing.close()
+            os.close(folder)
+    return FilesUsage(total, entries, deepest)

@@ -225,12 +225,16 @@ def _setfacl(change, paths):
 WRITABLE_ROOTS = ("/tmp", "/var/tmp", "/dev/shm", "/run/lock", "/var/lock", "/dev/mqueue")
 
 
-def files_of(uid, roots=WRITABLE_ROOTS, into_own=False):
+WORLD_WRITABLE_DEPTH = 32  # levels of other users' world-writable folders searched for a uid's files
+
+
+def files_of(uid, roots=WRITABLE_ROOTS):
     """(path, stat) of every entry that ``uid`` owns below ``roots``; links never followed.
 
     A dedicated uid can create entries only where others may write: in
-    world-writable folders (recursed into, 32 levels at most) and in its own
-    folders (recursed into whole with ``into_own``; else listed as one entry).
+    world-writable folders (recursed into, :data:`WORLD_WRITABLE_DEPTH` levels
+    at most) and in its own folders (listed as one entry: removed whole, their
+    size summed by :func:`grading.sandbox.usage.files_usage_of`).
     """
     stack = [(root, 0) for root in roots if root]
     while stack:
@@ -244,12 +248,9 @@ def files_of(uid, roots=WRITABLE_ROOTS, into_own=False):
                 info = entry.stat(follow_symlinks=False)
             except OSError:
                 continue
-            owned = info.st_uid == uid
-            if owned:
+            if info.st_uid == uid:
                 yield entry.path, info
-            if not stat.S_ISDIR(info.st_mode):
-                continue
-            if (owned and into_own) or (not owned and info.st_mode & stat.S_IWOTH and depth < 32):
+            elif stat.S_ISDIR(info.st_mode) and info.st_mode & stat.S_IWOTH and depth < WORLD_WRITABLE_DEPTH:
                 stack.append((entry.path, depth + 1))
 
 

@@ -111,6 +111,32 @@ CHILDREN = textwrap.dedent(
         time.sleep(rest)
         return written
 
+    def _nested(levels, name):
+        # A descriptor of a folder `levels` deep below the working folder (the home), each named
+        # `name`: made by descriptors, so the path may pass PATH_MAX.
+        folder = os.open(".", os.O_RDONLY)
+        for _ in range(levels):
+            os.mkdir(name, dir_fd=folder)
+            child = os.open(name, os.O_RDONLY, dir_fd=folder)
+            os.close(folder)
+            folder = child
+        return folder
+
+    def write_deep(levels, name_length, mib, rest):
+        folder = _nested(levels, "d" * name_length)
+        handle = os.open("fill", os.O_WRONLY | os.O_CREAT, 0o600, dir_fd=folder)
+        for _ in range(mib):
+            os.write(handle, b"x" * 2**20)
+        os.close(handle)
+        time.sleep(rest)
+        return "survived"
+
+    def make_empty_files(count, rest):
+        for i in range(count):
+            open(f"empty-{i}", "w").close()
+        time.sleep(rest)
+        return "survived"
+
     def writable_places():
         # Every mount of the sandbox where a file can be created, with its size (statvfs).
         found, seen = {}, set()
@@ -137,13 +163,14 @@ CHILDREN = textwrap.dedent(
 def make_worker(tmp_path):
     workers = []
 
-    def make(timeout=10):
+    def make(timeout=10, level="strongest"):
         package = tmp_path / "clone" / "pcl_course"
         if not package.exists():
             package.mkdir(parents=True)
             (package / "__init__.py").write_text("")
             (package / "children.py").write_text(CHILDREN)
-        worker = Worker(staged_root(package), timeout=timeout)
+        isolated = Isolation(UID, reserve_uid(), "namespaces switched off for the test") if level == "uid" else None
+        worker = Worker(staged_root(package), timeout=timeout, level=isolated)
         workers.append(worker)
         return worker
 
@@ -211,7 +238,8 @@ def test_a_call_under_its_cpu_limit_with_children_is_not_stopped(make_worker, mo
 
 
 needs_bubblewrap = pytest.mark.skipif(isolation().level != "bubblewrap", reason="needs bubblewrap")
-needs_uid_mode = pytest.mark.skipif(isolation().level != "uid", reason="needs the uid mode (root, no namespaces)")
+# The uid mode is the strongest level only where namespaces are forbidden: forced here as root.
+needs_uid_mode = pytest.mark.skipif(os.geteuid() != 0, reason="the uid mode needs root")
 
 
 @needs_bubblewrap
@@ -234,21 +262,46 @@ def test_writing_to_shm_and_the_masks_in_bubblewrap_fails_past_the_cap(make_work
 @needs_uid_mode
 def test_the_files_a_dedicated_uid_writes_are_bounded_for_the_worker(make_worker, monkeypatch):
     # Each file is under RLIMIT_FSIZE; together they are over the uid's disk limit (32 MiB here).
+    # Where Landlock confines the uid's files to its home ("."), /tmp and /dev/shm refuse them.
     monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
     monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
-    worker = make_worker()
+    worker = make_worker(level="uid")
     with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
-        worker.call("children", "write_files", (["/tmp", "/dev/shm"], 8, 4, 3.0), {})
+        worker.call("children", "write_files", (["/tmp", "/dev/shm", "."], 8, 4, 3.0), {})
 
 
 @needs_uid_mode
 def test_short_calls_of_a_dedicated_uid_cannot_add_up_files_past_the_limit(make_worker, monkeypatch):
     # No call lasts long enough for a reading of its own: the files are summed every 0.25 s anyway.
     monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
-    worker = make_worker()
+    worker = make_worker(level="uid")
     with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
         for _ in range(40):
-            worker.call("children", "write_files", (["/tmp"], 4, 1, 0.05), {})
+            worker.call("children", "write_files", (["/tmp", "."], 4, 1, 0.05), {})
+
+
+@needs_uid_mode
+def test_files_below_a_path_past_path_max_count_against_the_disk_limit(make_worker, monkeypatch):
+    # 30 folders of 200 characters: a path of over 6,000 (PATH_MAX is 4,096), which a walk by
+    # path strings could not name (1,000 MB were written past a 320 MiB limit that way).
+    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(level="uid")
+    with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
+        worker.call("children", "write_deep", (30, 200, 48, 3.0), {})
+
+
+@needs_uid_mode
+def test_a_dedicated_uid_may_own_only_so_many_files_and_nest_folders_only_so_deep(make_worker, monkeypatch):
+    # Empty files take no block: counted by entries (300,000 of them passed the byte limit, and
+    # each reading of them cost the grader about a second).
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(level="uid")
+    with pytest.raises(SandboxError, match=rf"made more than {config.FILES_LIMIT} files and folders"):
+        worker.call("children", "make_empty_files", (config.FILES_LIMIT + 1_000, 3.0), {})
+    worker = make_worker(level="uid")
+    with pytest.raises(SandboxError, match=rf"nested folders more than {config.FOLDER_DEPTH_LIMIT} deep"):
+        worker.call("children", "write_deep", (config.FOLDER_DEPTH_LIMIT + 10, 1, 0, 3.0), {})
 
 
 # -- the grader's own memory: what a grading keeps for the diagnosis ---------------------------
