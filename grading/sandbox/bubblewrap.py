@@ -9,16 +9,20 @@ protocol; a size-capped tmpfs for ``/tmp`` (also ``HOME``) and a smaller one for
 ``/dev/shm``, the only writable places (the masks and ``/dev`` itself are
 read-only); its own ``/proc`` and a minimal ``/dev``. No repository,
 ``.git``, tests, solutions, ``grading/`` or other submission exists there.
+The worker runs under the seccomp filter of the calls denied in every mode
+(:data:`grading.sandbox.worker.DENIED_EVERYWHERE`), compiled here and
+handed to ``bwrap --seccomp`` (:func:`seccomp_program`).
 """
 
 import os
 import subprocess
 import sys
+import tempfile
 from functools import cache
 from pathlib import Path
 
 from grading import config
-from grading.sandbox.worker import SYSTEM_LIBRARIES
+from grading.sandbox.worker import SYSTEM_LIBRARIES, syscall_filter
 
 WORKER = Path(__file__).with_name("worker.py")  # the script a worker runs
 PROTOCOL = Path(__file__).with_name("protocol.py")  # the wire format, beside it in every staging folder
@@ -223,23 +227,44 @@ def bubblewrap_command(staged_root, python_argv_tail, extra=()):
     return [*command, "--", python, "-I", "-S", SANDBOX_WORKER, SANDBOX_SITE, SANDBOX_SUBMISSION, *python_argv_tail]
 
 
+@cache
+def seccomp_program():
+    """The compiled (cBPF) seccomp filter of :data:`grading.sandbox.worker.DENIED_EVERYWHERE`,
+    as ``bwrap --seccomp`` reads it: the sandbox has no ``ldconfig`` to find libseccomp by."""
+    import pyseccomp
+
+    with tempfile.TemporaryFile() as compiled:
+        syscall_filter(pyseccomp, network=False).export_bpf(compiled)
+        compiled.seek(0)
+        return compiled.read()
+
+
+def _pipe_of(data):
+    """The read end of a pipe that holds ``data`` (a few kB at most: the pipe's buffer) and is closed."""
+    read, write = os.pipe()
+    try:
+        os.write(write, data)
+    finally:
+        os.close(write)
+    return read
+
+
 def spawn(command, **kwargs):
     """Start ``command``; a ``bwrap`` command gets its arguments through a pipe
     (``--args FD``), so that no path of the grader's shows in the sandbox's
-    ``/proc/1/cmdline``."""
+    ``/proc/1/cmdline``, and its seccomp filter through another (``--seccomp FD``)."""
     if command[0] != "bwrap":
         return subprocess.Popen(command, **kwargs)
     end = command.index("--")  # the options go through the pipe, the sandbox's own command line stays
-    read, write = os.pipe()
+    program = _pipe_of(seccomp_program())
+    options = [*command[1:end], "--seccomp", str(program)]
+    read = _pipe_of(b"".join(arg.encode() + b"\0" for arg in options))
     try:
-        os.write(write, b"".join(arg.encode() + b"\0" for arg in command[1:end]))
-    finally:
-        os.close(write)
-    try:
-        passed = (read, *kwargs.pop("pass_fds", ()))
+        passed = (read, program, *kwargs.pop("pass_fds", ()))
         return subprocess.Popen(["bwrap", "--args", str(read), *command[end:]], pass_fds=passed, **kwargs)
     finally:
         os.close(read)
+        os.close(program)
 
 
 def environment(home):

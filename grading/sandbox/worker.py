@@ -71,7 +71,6 @@ SOCK_STREAM, SOCK_SEQPACKET = 1, 5  # <linux/net.h>: the socket pairs that canno
 # path (bind, connect, listen on a socket pair); and every new process.
 _DENIED_CALLS = (
     "socket",
-    "io_uring_setup",
     "shmget",
     "msgget",
     "semget",
@@ -91,11 +90,54 @@ _DENIED_CALLS = (
 )
 
 
+# Denied in every mode, bubblewrap too (the grader compiles them for bwrap's --seccomp:
+# grading.sandbox.bubblewrap.seccomp_program), each with its errno: what would put storage out of
+# the limits' sight. A descriptor passed through a socket pair (SCM_RIGHTS) and closed by its sender
+# is in no folder and in no process's table: a memfd or a deleted file held so (5 GiB of RAM,
+# 8 GiB of disk) was counted nowhere; io_uring's registered files are the same. POSIX message
+# queues outlive every process of the uid, out of reach of its cleanup (a channel from one
+# submission to the next). fallocate takes GiBs in milliseconds, between two readings of the disk;
+# refused with EOPNOTSUPP, glibc's posix_fallocate writes the blocks itself, at the speed of writing.
+DENIED_EVERYWHERE = {
+    "sendmsg": errno.EACCES,
+    "sendmmsg": errno.EACCES,
+    "recvmsg": errno.EACCES,
+    "recvmmsg": errno.EACCES,
+    "io_uring_setup": errno.EACCES,
+    "mq_open": errno.EACCES,
+    "mq_unlink": errno.EACCES,
+    "mq_timedsend": errno.EACCES,
+    "mq_timedreceive": errno.EACCES,
+    "mq_notify": errno.EACCES,
+    "mq_getsetattr": errno.EACCES,
+    "fallocate": errno.EOPNOTSUPP,
+}
+
+
+def syscall_filter(seccomp, network=True):
+    """A libseccomp filter (``seccomp``: the pyseccomp module) of :data:`DENIED_EVERYWHERE` and,
+    with ``network``, of the network and new processes (:func:`close_network`)."""
+    deny = seccomp.SyscallFilter(seccomp.ALLOW)
+    for call, code in DENIED_EVERYWHERE.items():
+        deny.add_rule(seccomp.ERRNO(code), call)
+    if network:
+        for call in _DENIED_CALLS:
+            deny.add_rule(seccomp.ERRNO(errno.EACCES), call)
+        for kind in range(16):  # socketpair's type, its flags masked off: a stream or a sequenced pair only
+            if kind not in (SOCK_STREAM, SOCK_SEQPACKET):
+                deny.add_rule(seccomp.ERRNO(errno.EACCES), "socketpair", seccomp.Arg(1, seccomp.MASKED_EQ, 0xF, kind))
+        deny.add_rule(seccomp.ERRNO(errno.EACCES), "clone", seccomp.Arg(0, seccomp.MASKED_EQ, CLONE_THREAD, 0))
+        deny.add_rule(seccomp.ERRNO(errno.ENOSYS), "clone3")  # its flags are in memory: no rule can read them
+    return deny
+
+
 def close_network():
     """Install a seccomp filter that fails every ``socket()`` (any address
     family; ``socketpair()`` of a stream or a sequenced-packet pair stays,
     which can reach no other socket) and ``io_uring_setup()`` (io_uring can
-    open sockets) with ``EACCES``, for this process and all it starts; and
+    open sockets) with ``EACCES``, for this process and all it starts, with
+    every call of :data:`DENIED_EVERYWHERE` (``sendmsg``: no descriptor
+    passed through a socket pair; POSIX message queues; ``fallocate``); and
     ``bind``, ``connect``, ``listen`` (a datagram pair could otherwise send
     to any socket named by a path); ``shmget``, ``msgget`` and ``semget``
     (SysV IPC objects outlive their processes) and ``add_key``,
@@ -120,15 +162,7 @@ def close_network():
     try:
         import pyseccomp as seccomp  # libseccomp's Python API, over ctypes
 
-        deny = seccomp.SyscallFilter(seccomp.ALLOW)
-        for call in _DENIED_CALLS:
-            deny.add_rule(seccomp.ERRNO(errno.EACCES), call)
-        for kind in range(16):  # socketpair's type, its flags masked off: a stream or a sequenced pair only
-            if kind not in (SOCK_STREAM, SOCK_SEQPACKET):
-                deny.add_rule(seccomp.ERRNO(errno.EACCES), "socketpair", seccomp.Arg(1, seccomp.MASKED_EQ, 0xF, kind))
-        deny.add_rule(seccomp.ERRNO(errno.EACCES), "clone", seccomp.Arg(0, seccomp.MASKED_EQ, CLONE_THREAD, 0))
-        deny.add_rule(seccomp.ERRNO(errno.ENOSYS), "clone3")  # its flags are in memory: no rule can read them
-        deny.load()  # sets no_new_privs first
+        syscall_filter(seccomp).load()  # sets no_new_privs first
     except Exception as exc:  # no libseccomp, or a kernel or container that refuses filters
         return f"no seccomp filter ({type(exc).__name__}: {exc})"
     return None

@@ -10,6 +10,7 @@ time, not the wall clock, so that a busy machine changes no verdict.
 """
 
 import ast
+import errno
 import math
 import os
 import subprocess
@@ -136,6 +137,44 @@ CHILDREN = textwrap.dedent(
             open(f"empty-{i}", "w").close()
         time.sleep(rest)
         return "survived"
+
+    def hold_deleted(mib, how, rest):
+        # A file written, then deleted while open or mapped (its descriptor closed): no folder lists it.
+        import mmap
+
+        handle = os.open("held", os.O_RDWR | os.O_CREAT, 0o600)
+        for _ in range(mib):
+            os.write(handle, b"x" * 2**20)
+        mapped = mmap.mmap(handle, mib * 2**20) if how == "mapped" else None
+        if mapped is not None:
+            os.close(handle)
+        os.unlink("held")
+        time.sleep(rest)
+        return "survived"
+
+    def hiding_places():
+        # Where storage could be held out of the limits' sight: a descriptor in transit through a
+        # socket pair, a message queue that outlives the uid's processes, blocks taken at once.
+        import ctypes
+        import socket
+
+        found, libc = {}, ctypes.CDLL(None, use_errno=True)
+        left, right = socket.socketpair()
+        try:
+            socket.send_fds(left, [b"x"], [left.fileno()])
+            found["send_fds"] = "sent"
+        except PermissionError:
+            found["send_fds"] = "refused"
+        handle = os.open("fallocated", os.O_WRONLY | os.O_CREAT, 0o600)
+        failed = libc.fallocate(handle, 0, ctypes.c_long(0), ctypes.c_long(2**20))
+        found["fallocate"] = ctypes.get_errno() if failed else "allocated"
+        os.close(handle)
+        os.unlink("fallocated")
+        queue = libc.mq_open(b"/pcl-course-test", os.O_CREAT | os.O_RDWR, 0o600, None)
+        found["mq_open"] = ctypes.get_errno() if queue < 0 else "opened"
+        if queue >= 0:
+            libc.mq_unlink(b"/pcl-course-test")
+        return found
 
     def writable_places():
         # Every mount of the sandbox where a file can be created, with its size (statvfs).
@@ -302,6 +341,44 @@ def test_a_dedicated_uid_may_own_only_so_many_files_and_nest_folders_only_so_dee
     worker = make_worker(level="uid")
     with pytest.raises(SandboxError, match=rf"nested folders more than {config.FOLDER_DEPTH_LIMIT} deep"):
         worker.call("children", "write_deep", (config.FOLDER_DEPTH_LIMIT + 10, 1, 0, 3.0), {})
+
+
+@needs_uid_mode
+def test_the_walk_of_a_uids_files_leaves_their_access_times_alone(tmp_path):
+    """h75: listing a folder set its access time (relatime), by which a submission saw the walk
+    arrive and moved its files out of its way: 26 walks dodged in 8 s."""
+    from grading.sandbox.usage import files_usage_of
+
+    inner = tmp_path / "home" / "inner"
+    inner.mkdir(parents=True)
+    (inner / "data").write_bytes(b"x" * 8192)
+    for folder in (tmp_path / "home", inner):
+        os.utime(folder, (1_000_000, 1_000_000))
+    uid = os.getuid()
+    assert files_usage_of(uid, [str(tmp_path)]).bytes >= 8192
+    assert [os.stat(folder).st_atime for folder in (tmp_path / "home", inner)] == [1_000_000, 1_000_000]
+
+
+@needs_uid_mode
+@pytest.mark.parametrize("how", ["open", "mapped"])
+def test_files_deleted_while_held_count_against_the_disk_limit(make_worker, monkeypatch, how):
+    # h75: 3 GiB deleted while open counted as memory only (its limit 4 GiB), and 3 GiB mapped, its
+    # descriptor closed, nowhere (its pages untouched: no Pss).
+    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
+    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
+    worker = make_worker(level="uid")
+    with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
+        worker.call("children", "hold_deleted", (48, how, 3.0), {})
+
+
+@pytest.mark.parametrize("level", ["strongest", pytest.param("uid", marks=needs_uid_mode)])
+def test_no_storage_can_be_held_out_of_the_limits_sight(make_worker, level):
+    """A hostile review (h75): a memfd or a deleted file passed through a socket pair and closed is in
+    no folder and no process's table (5 GiB of RAM, 8 GiB of disk held, counted nowhere); a POSIX
+    message queue outlived the uid's cleanup (16 bits carried to the next submission); fallocate took
+    10 GiB between two readings of the disk. Refused in every mode, bubblewrap included."""
+    found = make_worker(level=level).call("children", "hiding_places", (), {})
+    assert found == {"send_fds": "refused", "fallocate": errno.EOPNOTSUPP, "mq_open": errno.EACCES}, found
 
 
 # -- the grader's own memory: what a grading keeps for the diagnosis ---------------------------
