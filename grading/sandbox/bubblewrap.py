@@ -231,12 +231,15 @@ def bubblewrap_command(staged_root, python_argv_tail, extra=()):
 def seccomp_program():
     """The compiled (cBPF) seccomp filter of :data:`grading.sandbox.worker.DENIED_EVERYWHERE`,
     as ``bwrap --seccomp`` reads it: the sandbox has no ``ldconfig`` to find libseccomp by."""
-    import pyseccomp
+    try:
+        import pyseccomp
 
-    with tempfile.TemporaryFile() as compiled:
-        syscall_filter(pyseccomp, network=False).export_bpf(compiled)
-        compiled.seek(0)
-        return compiled.read()
+        with tempfile.TemporaryFile() as compiled:
+            syscall_filter(pyseccomp, network=False).export_bpf(compiled)
+            compiled.seek(0)
+            return compiled.read()
+    except Exception as exc:  # no libseccomp: bubblewrap is then not a level this machine has
+        raise OSError(f"no seccomp filter for bubblewrap ({type(exc).__name__}: {exc})") from None
 
 
 def _pipe_of(data):
