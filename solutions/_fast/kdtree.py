@@ -270,7 +270,7 @@ def radius_rows(order, start, stop, axis, split, left, right, stack_size, points
         c, out_s, out_i = _radius_walk(
             order, start, stop, axis, split, left, right, points, queries[rows[qi]], r2, stack, out_s, out_i
         )
-        all_i, all_d, filled = append_row(all_i, all_d, filled, out_s, out_i, c)
+        all_i, all_d, filled = append_row(all_i, all_d, filled, out_s, out_i, c, qi - first + 1, last - first)
         counts[qi - first] = c
     return counts, all_i[:filled], all_d[:filled]
 
