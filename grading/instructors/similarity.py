@@ -19,21 +19,20 @@ Each entry of the class folder is read as ``batch`` and Gradescope read it
 link followed), so a link in a submission never puts another file's text
 into the report, and each module is decoded as Python decodes it (a PEP 263
 coding line honoured). The grader runs every file of the package, so a copy
-may sit in any of them (a helper module of the student's own, or another
-exercise module the first imports): each student's module is also compared
-with the other student's whole package (every ``.py`` file that is not the
-course's own), and that pair is kept where it finds more. Code a module
-builds while it runs (``exec``, ``eval``, ``compile``: a copy compressed into
-one string literal) cannot be compared: each such call is listed, to be read
-by hand. Every entry or file not compared is listed, with why (one over
-:data:`REPORT_FILE_LIMIT` characters, among them).
+may sit in any of them (a helper module of the student's own, another
+exercise module the first imports, the copier's own module left as the stub):
+every file of each student's package is also compared with each other
+student's whole package (:func:`_package_pairs`), and such a pair is kept
+where it finds more. What cannot be compared is listed, with why, to be read
+by hand (:mod:`grading.instructors.submitted_code`): an entry not graded, a
+file that is not Python or is over the report's caps, and code a module loads
+or builds while it runs (``exec``, ``importlib``, ``marshal``, ``sys.path``).
 Students' folder names are shown escaped (:func:`grading.results.clean`). The report is one self-contained
 HTML page (no script, no web font, no stylesheet fetched): the pairs ranked
 by similarity, each with both files side by side and the shared code
 highlighted. A high score is a reason to read the two files, not a verdict.
 """
 
-import ast
 import html
 import io
 import itertools
@@ -49,10 +48,10 @@ from copydetect.utils import highlight_overlap
 
 from grading import EXERCISE_MODULES, REPO_ROOT
 from grading.errors import StagingError
-from grading.forbidden import read_source
 from grading.instructors.batch import class_folders, read_gradescope_metadata
 from grading.instructors.dead_code import comparable, without_texts
 from grading.instructors.gradescope import lay_over_stubs
+from grading.instructors.submitted_code import Submitted, module_texts, read_package
 from grading.results import clean
 
 NOISE_TOKENS = 25  # copydetect's default k: shorter shared runs are noise
@@ -67,15 +66,12 @@ COMMON_MIN_STUDENTS = 3
 FAMILY_SHARE = 0.8
 DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
-# Characters of one file the report compares and shows: the reference's longest module has 27,000;
-# a student's 3.5 MB file took a 3-student report 3.5 minutes and 8 MB of HTML (h72).
-REPORT_FILE_LIMIT = 200_000
-# A module compared with the other's whole package is kept when a share of its fingerprints larger than
-# the module-to-module pair's by this much is there (a cheap count first; the highlighting only then).
-PACKAGE_MARGIN = 0.1
+# Every file of a student's package is also compared with each other student's whole package, so
+# that a copy kept in any file is found (h72, h76): such a pair is kept when it shares at least this
+# many tokens (a small module's seam with a stub matched 33 tokens of an unrelated package: h76).
+PACKAGE_MIN_TOKENS = 60
 PACKAGE_VIEW = "found in the other's package"
 FILE_HEADER = "# ==== {} ====\n"  # before each file of a package's text
-RUNTIME_CODE = frozenset({"exec", "eval", "compile"})  # calls whose code is built while the module runs
 # Each pair is compared twice, the higher share kept: as Python reads the files (what does nothing
 # removed: a padding between the lines of a copy is gone) and as submitted (only the texts that are no
 # code removed: whatever the normaliser mistook for dead code is there). Normalising can then only
@@ -174,72 +170,9 @@ def _common_line(module, common):
     )
 
 
-@dataclass(frozen=True)
-class Submitted:
-    """One student's code as the report reads it: ``modules``, each exercise module's text (a module
-    written as a package: its files together), and ``package``, every ``.py`` file of the package that
-    is not the course's own, by its path in the package."""
-
-    modules: dict
-    package: dict  # relative path -> text
-
-
 def _package_text(files, prepare):
     """One text of a package's ``files``, each prepared alone (a file's names are its own) after its header."""
     return "".join(FILE_HEADER.format(relative) + prepare(text) for relative, text in files.items())
-
-
-def _runtime_code(text):
-    """The lines of the calls of ``exec``, ``eval`` or ``compile`` (by name or ``builtins.``) in ``text``."""
-    try:
-        tree = ast.parse(text)
-    except (SyntaxError, ValueError):
-        return []
-    lines = []
-    for node in ast.walk(tree):
-        if not isinstance(node, ast.Call):
-            continue
-        func = node.func
-        name = func.id if isinstance(func, ast.Name) else func.attr if isinstance(func, ast.Attribute) else None
-        if name in RUNTIME_CODE and (isinstance(func, ast.Name) or _dotted_root(func) == "builtins"):
-            lines.append((node.lineno, name))
-    return sorted(lines)
-
-
-def _dotted_root(node):
-    while isinstance(node, ast.Attribute):
-        node = node.value
-    return node.id if isinstance(node, ast.Name) else None
-
-
-def _read_package(package, name, stubs):
-    """({relative path: text} of every ``.py`` file of ``package`` that is not the stubs' own, lines on
-    what was not read): decoded as Python decodes it, each under :data:`REPORT_FILE_LIMIT` characters."""
-    texts, lines = {}, []
-    for path in sorted(package.rglob("*.py")):
-        relative = path.relative_to(package).as_posix()
-        course = Path(stubs) / relative
-        if path.is_symlink() or not path.is_file():
-            continue  # the laid-over copy holds regular files only
-        if course.is_file() and course.read_bytes() == path.read_bytes():
-            continue
-        try:
-            text = read_source(path)
-        except (SyntaxError, OSError) as exc:
-            reason = exc.msg if isinstance(exc, SyntaxError) else exc.strerror
-            lines.append(f"{name}: {relative} not compared: {reason}")
-            continue
-        if len(text) > REPORT_FILE_LIMIT:
-            lines.append(
-                f"{name}: {relative} not compared: {len(text):,} characters, over the report's {REPORT_FILE_LIMIT:,}"
-            )
-            continue
-        calls = _runtime_code(text)
-        if calls:
-            where = ", ".join(f"{call} at line {line}" for line, call in calls[:5])
-            lines.append(f"{name}: {relative} runs code it builds while it runs ({where}): that code is not compared")
-        texts[relative] = text
-    return texts, lines
 
 
 def _student_modules(class_dir, into, stubs=REPO_ROOT / "pcl_course"):
@@ -265,22 +198,18 @@ def _student_modules(class_dir, into, stubs=REPO_ROOT / "pcl_course"):
         except StagingError as exc:
             skipped.append(f"{name}: not compared: {exc}")
             continue
-        files, lines = _read_package(assembled.package, name, stubs)
+        files, lines = read_package(assembled.package, name, stubs)
         skipped += lines
-        modules = {}
-        for module in assembled.found:
-            own = [text for relative, text in files.items() if relative.split("/")[0] in (module, f"{module}.py")]
-            if own:
-                modules[module] = "\n".join(own)
-        students[name] = Submitted(modules, files)
+        students[name] = Submitted(module_texts(files, assembled.found), files)
     return students, skipped
 
 
 def _compared(module, first, second, view, fingerprints, other=None):
     """The :class:`Pair` of two students' versions in one view, or None if they share no code.
 
-    With ``other`` (the second's package fingerprint), the first's module is compared with it: the
-    second's side then shows only the files that share code."""
+    With ``other`` (the second's package fingerprint), ``fingerprints[first]`` (one file of the
+    first's, ``module`` its path without ``.py``) is compared with it: the second's side then shows
+    only the files that share code."""
     a, b = fingerprints[first], other if other is not None else fingerprints[second]
     tokens, (share_a, share_b), (slices_a, slices_b) = compare_files(a, b)
     if tokens == 0:
@@ -309,26 +238,29 @@ def _files_sharing_code(highlighted):
     return "".join(marker + piece for piece in pieces[1:] if HIGHLIGHT[0] in piece) or highlighted
 
 
-def _hash_share(hashes, others):
-    """The share of the fingerprints ``hashes`` (a set) found in ``others``: a cheap bound's stand-in."""
-    return len(hashes & others) / len(hashes) if hashes else 0.0
+def _package_pairs(submitted, view, prepare, left_out, pairs):
+    """Every file of each student's package compared with each other student's whole package in one
+    ``view``, into ``pairs`` (keyed as :func:`compare_class` keys them) where it finds a larger share.
 
-
-def _package_pairs(module, view, module_prints, package_prints, best):
-    """Each student's ``module`` compared with each other student's package in one ``view``: into
-    ``best`` (the pairs so far, by their two names sorted) goes each pair that finds a larger share."""
-    own = {student: set(f.hashes) for student, f in module_prints.items()}
-    packages = {student: set(f.hashes) for student, f in package_prints.items()}
-    for first, second in itertools.permutations(sorted(own), 2):
-        if second not in packages:
-            continue
-        key = tuple(sorted((first, second)))
-        known = best[key].similarity if key in best else 0.0
-        if _hash_share(own[first], packages[second]) <= known + PACKAGE_MARGIN:
-            continue
-        pair = _compared(module, first, second, view, module_prints, package_prints[second])
-        if pair is not None and pair.first_share > known:
-            best[key] = pair
+    What is common in any module (``left_out``) and what most of the class's packages hold alike is
+    left out. A file and a package that share no fingerprint are not compared further."""
+    packages = {student: _package_text(files.files, prepare) for student, files in submitted.items() if files.files}
+    left_out, _ = _common_hashes("package", packages, left_out, str)
+    package_prints = _fingerprints("package", packages, left_out, str)
+    package_hashes = {student: set(f.hashes) for student, f in package_prints.items()}
+    for first in sorted(packages):
+        for relative, text in submitted[first].files.items():
+            label = relative.removesuffix(".py")
+            own = {first: CodeFingerprint(relative, NOISE_TOKENS, 1, left_out, fp=io.StringIO(prepare(text)))}
+            hashes = set(own[first].hashes)
+            for second in sorted(packages):
+                if second == first or not hashes & package_hashes[second]:
+                    continue
+                key = (label, *sorted((first, second))) if label in EXERCISE_MODULES else (label, first, second)
+                known = pairs[key].similarity if key in pairs else 0.0
+                pair = _compared(label, first, second, view, own, package_prints[second])
+                if pair is not None and pair.shared_tokens >= PACKAGE_MIN_TOKENS and pair.first_share > known:
+                    pairs[key] = pair
 
 
 def submitted_by(folder, submitters=None):
@@ -368,29 +300,25 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     people, problems = read_gradescope_metadata(Path(class_dir))
     skipped = problems + skipped
     submitted = {submitted_by(folder, people.get(folder)): files for folder, files in submitted.items()}
-    pairs, module_prints, left_out = {}, {}, {view: [boilerplate[view]] for view in VIEWS}
+    pairs, left_out = {}, {view: [boilerplate[view]] for view in VIEWS}  # pairs: (module, first, second) -> Pair
     for module in EXERCISE_MODULES:
         texts = {student: files.modules[module] for student, files in submitted.items() if module in files.modules}
-        module_prints[module], pairs[module] = {}, {}
+        module_prints = {}
         for view, prepare in VIEWS.items():
             module_left_out, common = _common_hashes(module, texts, boilerplate[view], prepare)
             left_out[view].append(module_left_out)
-            module_prints[module][view] = _fingerprints(module, texts, module_left_out, prepare)
+            module_prints[view] = _fingerprints(module, texts, module_left_out, prepare)
             if prepare is comparable:
                 skipped += [line for line in [_common_line(module, common)] if line]
         for first, second in itertools.combinations(sorted(texts), 2):
-            compared = [_compared(module, first, second, view, module_prints[module][view]) for view in VIEWS]
+            compared = [_compared(module, first, second, view, module_prints[view]) for view in VIEWS]
             compared = [pair for pair in compared if pair is not None]
             if compared:  # the first view on a tie
-                pairs[module][first, second] = max(compared, key=lambda pair: pair.similarity)
-    # A copy kept in another file of the package: what is common in any module is left out of the packages.
-    packages = {student: files.package for student, files in submitted.items() if files.package}
+                pairs[module, first, second] = max(compared, key=lambda pair: pair.similarity)
+    # A copy kept in any file of the package, the copier's own module left as the stub or not.
     for view, prepare in VIEWS.items():
-        texts = {student: _package_text(files, prepare) for student, files in packages.items()}
-        package_prints = _fingerprints("package", texts, np.unique(np.concatenate(left_out[view])), str)
-        for module in EXERCISE_MODULES:
-            _package_pairs(module, view, module_prints[module][view], package_prints, pairs[module])
-    pairs = [pair for found in pairs.values() for pair in found.values()]
+        _package_pairs(submitted, view, prepare, np.unique(np.concatenate(left_out[view])), pairs)
+    pairs = list(pairs.values())
     pairs.sort(key=lambda pair: (-pair.similarity, pair.module, pair.first, pair.second))
     return pairs, skipped
 

@@ -441,24 +441,60 @@ def test_a_copy_moved_into_another_file_of_the_package_is_compared(tmp_path):
     assert "bob, the package" in page and "alice, pca.py" in page
 
 
-def test_code_built_while_a_module_runs_is_listed_and_a_huge_file_is_not_compared(tmp_path, monkeypatch):
-    """A hostile review (h72): a copy inside exec(zlib.decompress(base64...)) folds to one string literal
-    and matched nothing; a 3.5 MB file took a 3-student report 3.5 minutes. The first is listed to be
-    read by hand, the second left out with its size."""
+def test_a_copy_in_helpers_is_found_whether_or_not_the_copier_changed_the_module(tmp_path):
+    """A hostile review (h76): a student who left pca.py as the stub and pointed it at a copy in a
+    helper (three lines in __init__.py) was never compared; nor was a helper copied into a helper.
+    Every file of each package is compared with each other package."""
+    student(tmp_path, "alice", ALICE)
+    wired = student(tmp_path, "bob")  # pca.py is the stub
+    (wired / "impl_helpers.py").write_text(pca_source(ALICE))
+    init = "from pcl_course import impl_helpers as _impl, pca as _pca\n_pca.pca = _impl.pca\n"
+    (wired / "__init__.py").write_text((wired / "__init__.py").read_text() + init)
+    for name, helper in (("carol", "_core.py"), ("dave", "linalg_utils.py")):  # carol's helper, copied by dave
+        package = student(tmp_path, name)
+        (package / helper).write_text(pca_source(CAROL))
+        (package / "pca.py").write_text(f"from pcl_course.{helper[:-3]} import pca  # noqa: F401\n")
+    student(tmp_path, "erin", DAVE)  # independent: with her, the way all write as_points(...) is common
+    pairs, _ = compare_class(tmp_path)
+    best = {}
+    for pair in pairs:
+        key = frozenset((pair.first, pair.second))
+        best[key] = max(best.get(key, 0), pair.similarity)
+    assert best.get(frozenset(("alice", "bob")), 0) > 0.8 and best.get(frozenset(("carol", "dave")), 0) > 0.8, best
+    # alice and carol wrote their own: no pair across the two copies (erin's pca.py against alice's,
+    # the only two the module view compares, is as close as two versions alone are, with nothing common)
+    across = [key for key in best if len(key & {"alice", "bob"}) == 1 and len(key & {"carol", "dave"}) == 1]
+    assert all(best[key] < DISPLAY_THRESHOLD for key in across), best
+
+
+def test_code_loaded_while_a_module_runs_is_listed_and_the_caps_count_code(tmp_path, monkeypatch):
+    """Hostile reviews (h72, h76): a copy inside exec(zlib.decompress(base64...)), a zip on sys.path,
+    runpy on a .cfg file, marshal, a getattr of builtins matched nothing and said nothing; a 3.5 MB
+    file took a 3-student report 3.5 minutes, and a copy padded with comments passed a cap of raw
+    characters. Each place is listed, a file that is not Python too, and the caps count code."""
     import zlib
 
-    from grading.instructors import similarity
+    from grading.instructors import submitted_code
 
-    monkeypatch.setattr(similarity, "REPORT_FILE_LIMIT", 20_000)
+    monkeypatch.setattr(submitted_code, "CODE_LIMIT", 20_000)
     student(tmp_path, "alice", ALICE)
     packed = base64.b64encode(zlib.compress(textwrap.dedent(ALICE).encode())).decode()
     bob = student(tmp_path, "bob")
     (bob / "pca.py").write_text(
-        f"import base64, zlib\nexec(zlib.decompress(base64.b64decode({packed!r})))\nimport builtins\n"
-        "builtins.eval('1')\n"
+        f"import base64, zlib\nexec(zlib.decompress(base64.b64decode({packed!r})))\n"
+        "import builtins\nrun = getattr(builtins, 'ex' + 'ec')\n"
     )
-    carol = student(tmp_path, "carol", CAROL)
-    (carol / "notes.py").write_text("X = 1\n" * 4_000)  # 24,000 characters
+    (bob / "loader.py").write_text("import sys, runpy\nsys.path.insert(0, 'lib.zip')\nrunpy.run_path('notes.cfg')\n")
+    (bob / "notes.cfg").write_text("def pca(points): ...\n")
+    carol = student(tmp_path, "carol")
+    padding = "".join(f"# {'x' * 70}\n" for _ in range(3_500))  # 255,500 characters of comments
+    (carol / "pca.py").write_text(padding + pca_source(ALICE))
+    (carol / "notes.py").write_text("value_of_x = 100\n" * 2_000)  # 28,000 characters of code (layout not counted)
     pairs, skipped = compare_class(tmp_path)
-    assert "bob: pca.py runs code it builds while it runs (exec at line 2, eval at line 4): " in "\n".join(skipped)
-    assert "carol: notes.py not compared: 24,000 characters, over the report's 20,000" in skipped
+    lines = "\n".join(skipped)
+    assert "bob: pca.py loads or builds code while it runs (base64 at line 1, " not in lines  # base64 is data
+    assert "bob: pca.py loads or builds code while it runs (exec at line 2, builtins at line 3)" in lines, lines
+    assert "bob: loader.py loads or builds code while it runs (runpy at line 1, sys.path at line 2)" in lines
+    assert "bob: notes.cfg is not Python: not compared" in lines
+    assert "carol: notes.py not compared: 28,000 characters of code, over 20,000" in lines
+    assert any({p.first, p.second} == {"alice", "carol"} and p.similarity > 0.9 for p in pairs)
