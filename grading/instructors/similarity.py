@@ -68,8 +68,12 @@ DISPLAY_THRESHOLD = 0.33  # copydetect's default: pairs below it are not shown
 HIGHLIGHT = ('<mark class="shared">', "</mark>")
 # Every file of a student's package is also compared with each other student's whole package, so
 # that a copy kept in any file is found (h72, h76): such a pair is kept when it shares at least this
-# many tokens (a small module's seam with a stub matched 33 tokens of an unrelated package: h76).
+# many tokens (a small module's seam with a stub matched 33 tokens of an unrelated package: h76), in
+# runs of at least PACKAGE_RUN_TOKENS: a small file against a whole package gathers the short idioms
+# two independent students share from several files (a stub's seam, a validation idiom, an SVD call:
+# 30 % as modules, 59 % against the package, h78); a copy's runs are long.
 PACKAGE_MIN_TOKENS = 60
+PACKAGE_RUN_TOKENS = 40
 PACKAGE_VIEW = "found in the other's package"
 FILE_HEADER = "# ==== {} ====\n"  # before each file of a package's text
 # Each pair is compared twice, the higher share kept: as Python reads the files (what does nothing
@@ -110,17 +114,17 @@ class Pair:
         return max(self.first_share, self.second_share)
 
 
-def _boilerplate_hashes(stubs, prepare):
+def _boilerplate_hashes(stubs, prepare, tokens=NOISE_TOKENS):
     hashes = []
     for path in sorted(Path(stubs).glob("*.py")):
         text = prepare(path.read_text(encoding="utf-8"))
-        hashes.extend(CodeFingerprint(str(path), NOISE_TOKENS, 1, fp=io.StringIO(text)).hashes)  # k-gram hashes
+        hashes.extend(CodeFingerprint(str(path), tokens, 1, fp=io.StringIO(text)).hashes)  # k-gram hashes
     return np.unique(np.array(hashes))
 
 
-def _fingerprints(module, texts, boilerplate, prepare):
+def _fingerprints(module, texts, boilerplate, prepare, tokens=NOISE_TOKENS):
     return {
-        student: CodeFingerprint(f"{module}.py", NOISE_TOKENS, 1, boilerplate, fp=io.StringIO(prepare(text)))
+        student: CodeFingerprint(f"{module}.py", tokens, 1, boilerplate, fp=io.StringIO(prepare(text)))
         for student, text in texts.items()
     }
 
@@ -146,11 +150,11 @@ def _families(hashes):
     return list(families.values())
 
 
-def _common_hashes(module, texts, boilerplate, prepare):
+def _common_hashes(module, texts, boilerplate, prepare, tokens=NOISE_TOKENS):
     """The boilerplate plus every fingerprint too common in the class to mean copying, and those alone.
 
     A fingerprint counts once per family of near-copies (:func:`_families`)."""
-    hashes = {s: set(f.hashes) for s, f in _fingerprints(module, texts, boilerplate, prepare).items()}
+    hashes = {s: set(f.hashes) for s, f in _fingerprints(module, texts, boilerplate, prepare, tokens).items()}
     families = [family for family in _families(hashes) if any(hashes[s] for s in family)]
     counts = Counter(h for family in families for h in set().union(*(hashes[s] for s in family)))
     limit = max(COMMON_MIN_STUDENTS - 1, COMMON_SHARE * len(families))
@@ -212,7 +216,7 @@ def _compared(module, first, second, view, fingerprints, other=None):
     only the files that share code."""
     a, b = fingerprints[first], other if other is not None else fingerprints[second]
     tokens, (share_a, share_b), (slices_a, slices_b) = compare_files(a, b)
-    if tokens == 0:
+    if tokens < (PACKAGE_MIN_TOKENS if other is not None else 1):  # before the highlighting, which costs
         return None
     second_html = highlight_overlap(b.raw_code, slices_b, *HIGHLIGHT, escape_html=True)[0]
     if other is not None:
@@ -238,28 +242,29 @@ def _files_sharing_code(highlighted):
     return "".join(marker + piece for piece in pieces[1:] if HIGHLIGHT[0] in piece) or highlighted
 
 
-def _package_pairs(submitted, view, prepare, left_out, pairs):
+def _package_pairs(submitted, view, prepare, boilerplate, pairs):
     """Every file of each student's package compared with each other student's whole package in one
     ``view``, into ``pairs`` (keyed as :func:`compare_class` keys them) where it finds a larger share.
 
-    What is common in any module (``left_out``) and what most of the class's packages hold alike is
-    left out. A file and a package that share no fingerprint are not compared further."""
+    Fingerprints of :data:`PACKAGE_RUN_TOKENS` tokens; the stubs' (``boilerplate``, of that length)
+    and what most of the class's packages hold alike are left out. A file and a package that share
+    no fingerprint are not compared further."""
     packages = {student: _package_text(files.files, prepare) for student, files in submitted.items() if files.files}
-    left_out, _ = _common_hashes("package", packages, left_out, str)
-    package_prints = _fingerprints("package", packages, left_out, str)
+    left_out, _ = _common_hashes("package", packages, boilerplate, str, PACKAGE_RUN_TOKENS)
+    package_prints = _fingerprints("package", packages, left_out, str, PACKAGE_RUN_TOKENS)
     package_hashes = {student: set(f.hashes) for student, f in package_prints.items()}
     for first in sorted(packages):
         for relative, text in submitted[first].files.items():
             label = relative.removesuffix(".py")
-            own = {first: CodeFingerprint(relative, NOISE_TOKENS, 1, left_out, fp=io.StringIO(prepare(text)))}
-            hashes = set(own[first].hashes)
+            fingerprint = CodeFingerprint(relative, PACKAGE_RUN_TOKENS, 1, left_out, fp=io.StringIO(prepare(text)))
+            hashes = set(fingerprint.hashes)
             for second in sorted(packages):
                 if second == first or not hashes & package_hashes[second]:
                     continue
                 key = (label, *sorted((first, second))) if label in EXERCISE_MODULES else (label, first, second)
                 known = pairs[key].similarity if key in pairs else 0.0
-                pair = _compared(label, first, second, view, own, package_prints[second])
-                if pair is not None and pair.shared_tokens >= PACKAGE_MIN_TOKENS and pair.first_share > known:
+                pair = _compared(label, first, second, view, {first: fingerprint}, package_prints[second])
+                if pair is not None and pair.first_share > known:
                     pairs[key] = pair
 
 
@@ -300,13 +305,12 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
     people, problems = read_gradescope_metadata(Path(class_dir))
     skipped = problems + skipped
     submitted = {submitted_by(folder, people.get(folder)): files for folder, files in submitted.items()}
-    pairs, left_out = {}, {view: [boilerplate[view]] for view in VIEWS}  # pairs: (module, first, second) -> Pair
+    pairs = {}  # (module or file, first, second) -> Pair
     for module in EXERCISE_MODULES:
         texts = {student: files.modules[module] for student, files in submitted.items() if module in files.modules}
         module_prints = {}
         for view, prepare in VIEWS.items():
             module_left_out, common = _common_hashes(module, texts, boilerplate[view], prepare)
-            left_out[view].append(module_left_out)
             module_prints[view] = _fingerprints(module, texts, module_left_out, prepare)
             if prepare is comparable:
                 skipped += [line for line in [_common_line(module, common)] if line]
@@ -317,7 +321,7 @@ def compare_class(class_dir, stubs=REPO_ROOT / "pcl_course"):
                 pairs[module, first, second] = max(compared, key=lambda pair: pair.similarity)
     # A copy kept in any file of the package, the copier's own module left as the stub or not.
     for view, prepare in VIEWS.items():
-        _package_pairs(submitted, view, prepare, np.unique(np.concatenate(left_out[view])), pairs)
+        _package_pairs(submitted, view, prepare, _boilerplate_hashes(stubs, prepare, PACKAGE_RUN_TOKENS), pairs)
     pairs = list(pairs.values())
     pairs.sort(key=lambda pair: (-pair.similarity, pair.module, pair.first, pair.second))
     return pairs, skipped

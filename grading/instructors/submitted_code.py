@@ -25,12 +25,20 @@ RAW_LIMIT = 2_000_000  # characters of a file read at all
 CODE_LIMIT = 200_000
 # Of a whole package: 20 files of 199,000 characters took a 40-student report from 12 s to 80 s (h76).
 PACKAGE_CODE_LIMIT = 600_000
-# What loads or builds code while a module runs: names, modules and ``sys`` hooks.
-DYNAMIC_NAMES = frozenset({"exec", "eval", "compile", "__import__", "__builtins__", "__loader__"})
+# What loads or builds code while a module runs: names, modules and ``sys`` hooks; and the building
+# blocks that reach them without naming them (h78: ``getattr(print.__self__, "ex" + "ec")``,
+# ``vars(len.__self__)[...]``, ``(lambda: 0).__code__.replace(...)`` run by ``type(lambda: 0)``, a
+# copy kept as the docstring or in comments and run from ``__doc__`` or ``open(__file__)``).
+DYNAMIC_NAMES = frozenset(
+    {"exec", "eval", "compile", "__import__", "__builtins__", "__loader__", "__doc__", "__file__", "globals", "vars"}
+)
+DYNAMIC_ATTRIBUTES = frozenset({"__self__", "__code__", "__globals__", "__dict__", "__spec__", "__closure__"})
 DYNAMIC_MODULES = frozenset(
     {"importlib", "runpy", "marshal", "pickle", "zipimport", "types", "builtins", "code", "codeop", "ctypes", "imp"}
 )
 SYS_HOOKS = frozenset({"path", "meta_path", "path_hooks", "modules"})
+NAME_GETTERS = frozenset({"getattr", "setattr", "delattr"})  # flagged when the name is not a literal
+LONG_LITERAL = 2_000  # characters of a string or bytes literal (not a docstring) that may hold code
 _LAYOUT = frozenset({tokenize.COMMENT, tokenize.NL, tokenize.NEWLINE, tokenize.INDENT, tokenize.DEDENT})
 
 
@@ -62,19 +70,45 @@ def dynamic_code(text):
     except (SyntaxError, ValueError):
         return []
     found = set()
+    docstrings = {id(body[0].value) for body in _bodies(tree) if _is_docstring(body)}
     for node in ast.walk(tree):
         if isinstance(node, ast.Name) and node.id in DYNAMIC_NAMES:
             found.add((node.lineno, node.id))
         elif isinstance(node, ast.Attribute):
-            if node.attr in DYNAMIC_NAMES:
+            if node.attr in DYNAMIC_NAMES or node.attr in DYNAMIC_ATTRIBUTES:
                 found.add((node.lineno, node.attr))
             elif node.attr in SYS_HOOKS and isinstance(node.value, ast.Name) and node.value.id == "sys":
                 found.add((node.lineno, f"sys.{node.attr}"))
         elif isinstance(node, ast.Import):
             found.update((node.lineno, a.name) for a in node.names if a.name.split(".")[0] in DYNAMIC_MODULES)
-        elif isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] in DYNAMIC_MODULES:
-            found.add((node.lineno, node.module))
+            found.update((node.lineno, f"sys as {a.asname}") for a in node.names if a.name == "sys" and a.asname)
+        elif isinstance(node, ast.ImportFrom):
+            root = (node.module or "").split(".")[0]
+            if root in DYNAMIC_MODULES or root == "sys":
+                found.add((node.lineno, f"from {node.module} import"))
+        elif isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+            name, args = node.func.id, node.args
+            if name in NAME_GETTERS and len(args) > 1 and not isinstance(args[1], ast.Constant):
+                found.add((node.lineno, f"{name} of a computed name"))
+            elif name == "type" and len(args) == 1 and isinstance(args[0], ast.Lambda):
+                found.add((node.lineno, "type(lambda)"))
+        elif isinstance(node, ast.Constant) and isinstance(node.value, (str, bytes)):
+            if len(node.value) > LONG_LITERAL and id(node) not in docstrings:
+                found.add((node.lineno, f"a literal of {len(node.value):,} characters"))
     return sorted(found)
+
+
+def _bodies(tree):
+    """The statement lists that may open with a docstring: the module's, each function's and class's."""
+    yield tree.body
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            yield node.body
+
+
+def _is_docstring(body):
+    first = body[0] if body else None
+    return isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) and isinstance(first.value.value, str)
 
 
 def read_package(package, name, stubs):
