@@ -115,6 +115,9 @@ MEMORY_LIMIT = 4 * 1024**3  # bytes of address space of one worker
 CPU_LIMIT = 600  # CPU seconds for a worker's whole life
 PROCESS_LIMIT = 256  # processes of the sandbox user (fork bombs)
 FILE_SIZE_LIMIT = 256 * 1024**2  # bytes of any one file the worker writes
+# Descriptors a worker process may hold: each socket pair or pipe holds kernel buffers no reading
+# counts (20,000 allowed 10,000 pairs of them: h77); numpy, numba and the worker need a few dozen.
+OPEN_FILES_LIMIT = 1024
 TMP_SIZE = 256 * 1024**2  # bytes of the worker's private /tmp (tmpfs, bubblewrap only)
 SHM_SIZE = 64 * 1024**2  # bytes of its private /dev/shm (tmpfs, bubblewrap only): the only other writable place
 # Limits of one call as a whole, over every process it started (alive, zombie or orphaned),

@@ -59,6 +59,7 @@ def preexec(uid):
             (resource.RLIMIT_CPU, config.CPU_LIMIT),
             (resource.RLIMIT_FSIZE, config.FILE_SIZE_LIMIT),
             (resource.RLIMIT_CORE, 0),
+            (resource.RLIMIT_NOFILE, config.OPEN_FILES_LIMIT),
         ):
             try:
                 resource.setrlimit(limit, (value, value))
@@ -227,7 +228,11 @@ def unlisted_bytes(pid, counted):
     numbers shared across one reading of a call's processes; pre-filled to leave a file out).
     The mappings are read where the grader may (``map_files`` needs ``CAP_SYS_ADMIN``: root)."""
     total = 0
-    for folder in (f"/proc/{pid}/fd", f"/proc/{pid}/map_files"):
+    try:  # every thread's table: one of its own (unshare(CLONE_FILES)) is in no other's (h77)
+        tables = [f"/proc/{pid}/task/{task}/fd" for task in os.listdir(f"/proc/{pid}/task")]
+    except OSError:
+        tables = [f"/proc/{pid}/fd"]
+    for folder in (*tables, f"/proc/{pid}/map_files"):
         try:
             names = os.listdir(folder)
         except OSError:

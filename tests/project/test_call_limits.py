@@ -174,6 +174,23 @@ CHILDREN = textwrap.dedent(
         found["mq_open"] = ctypes.get_errno() if queue < 0 else "opened"
         if queue >= 0:
             libc.mq_unlink(b"/pcl-course-test")
+        secret = libc.syscall(447, 0)  # memfd_secret
+        found["memfd_secret"] = ctypes.get_errno() if secret < 0 else "made"
+        found["unshare"] = ctypes.get_errno() if libc.unshare(0x400) else "own table"  # CLONE_FILES
+        read, write = os.pipe()
+        try:
+            os.splice(read, write, 1, flags=os.SPLICE_F_NONBLOCK)
+            found["splice"] = "spliced"
+        except OSError as exc:
+            found["splice"] = exc.errno
+        try:
+            left.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, 8 * 2**20)
+            found["SO_SNDBUF"] = "grown"
+        except OSError as exc:
+            found["SO_SNDBUF"] = exc.errno
+        import resource
+
+        found["open files"] = resource.getrlimit(resource.RLIMIT_NOFILE)[1]
         return found
 
     def writable_places():
@@ -376,9 +393,13 @@ def test_no_storage_can_be_held_out_of_the_limits_sight(make_worker, level):
     """A hostile review (h75): a memfd or a deleted file passed through a socket pair and closed is in
     no folder and no process's table (5 GiB of RAM, 8 GiB of disk held, counted nowhere); a POSIX
     message queue outlived the uid's cleanup (16 bits carried to the next submission); fallocate took
-    10 GiB between two readings of the disk. Refused in every mode, bubblewrap included."""
+    10 GiB between two readings of the disk. Refused in every mode, bubblewrap included; and (h77) a
+    secret memfd (no block shown), pages pinned in pipes by splice, a thread's own descriptor table,
+    socket buffers grown to 8 MiB, 20,000 descriptors."""
     found = make_worker(level=level).call("children", "hiding_places", (), {})
-    assert found == {"send_fds": "refused", "fallocate": errno.EOPNOTSUPP, "mq_open": errno.EACCES}, found
+    refused = {"mq_open", "memfd_secret", "unshare", "splice", "SO_SNDBUF"}
+    expected = {"send_fds": "refused", "fallocate": errno.EOPNOTSUPP, **dict.fromkeys(refused, errno.EACCES)}
+    assert found == {**expected, "open files": config.OPEN_FILES_LIMIT}, found
 
 
 # -- the grader's own memory: what a grading keeps for the diagnosis ---------------------------
