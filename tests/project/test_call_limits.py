@@ -315,34 +315,37 @@ def test_writing_to_shm_and_the_masks_in_bubblewrap_fails_past_the_cap(make_work
     assert len(written) * 16 * 2**20 <= config.SHM_SIZE, f"{len(written)} files of 16 MiB in /dev/shm"
 
 
-@needs_uid_mode
-def test_the_files_a_dedicated_uid_writes_are_bounded_for_the_worker(make_worker, monkeypatch):
-    # Each file is under RLIMIT_FSIZE; together they are over the uid's disk limit (32 MiB here).
-    # Where Landlock confines the uid's files to its home ("."), /tmp and /dev/shm refuse them.
+@pytest.fixture
+def small_disk_uid_worker(make_worker, monkeypatch):
+    """A worker at the uid level whose files may take 32 MiB (and calls a wide wall-clock backstop)."""
     monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
     monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
-    worker = make_worker(level="uid")
+    return make_worker(level="uid")
+
+
+@needs_uid_mode
+def test_the_files_a_dedicated_uid_writes_are_bounded_for_the_worker(small_disk_uid_worker):
+    # Each file is under RLIMIT_FSIZE; together they are over the uid's disk limit (32 MiB here).
+    # Where Landlock confines the uid's files to its home ("."), /tmp and /dev/shm refuse them.
+    worker = small_disk_uid_worker
     with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
         worker.call("children", "write_files", (["/tmp", "/dev/shm", "."], 8, 4, 3.0), {})
 
 
 @needs_uid_mode
-def test_short_calls_of_a_dedicated_uid_cannot_add_up_files_past_the_limit(make_worker, monkeypatch):
+def test_short_calls_of_a_dedicated_uid_cannot_add_up_files_past_the_limit(small_disk_uid_worker):
     # No call lasts long enough for a reading of its own: the files are summed every 0.25 s anyway.
-    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
-    worker = make_worker(level="uid")
+    worker = small_disk_uid_worker
     with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
         for _ in range(40):
             worker.call("children", "write_files", (["/tmp", "."], 4, 1, 0.05), {})
 
 
 @needs_uid_mode
-def test_files_below_a_path_past_path_max_count_against_the_disk_limit(make_worker, monkeypatch):
+def test_files_below_a_path_past_path_max_count_against_the_disk_limit(small_disk_uid_worker):
     # 30 folders of 200 characters: a path of over 6,000 (PATH_MAX is 4,096), which a walk by
     # path strings could not name (1,000 MB were written past a 320 MiB limit that way).
-    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
-    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
-    worker = make_worker(level="uid")
+    worker = small_disk_uid_worker
     with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
         worker.call("children", "write_deep", (30, 200, 48, 3.0), {})
 
@@ -378,12 +381,10 @@ def test_the_walk_of_a_uids_files_leaves_their_access_times_alone(tmp_path):
 
 @needs_uid_mode
 @pytest.mark.parametrize("how", ["open", "mapped"])
-def test_files_deleted_while_held_count_against_the_disk_limit(make_worker, monkeypatch, how):
+def test_files_deleted_while_held_count_against_the_disk_limit(small_disk_uid_worker, how):
     # h75: 3 GiB deleted while open counted as memory only (its limit 4 GiB), and 3 GiB mapped, its
     # descriptor closed, nowhere (its pages untouched: no Pss).
-    monkeypatch.setattr(config, "DISK_LIMIT", 32 * 2**20, raising=False)
-    monkeypatch.setattr(config, "CALL_WALL_FACTOR", 20.0)
-    worker = make_worker(level="uid")
+    worker = small_disk_uid_worker
     with pytest.raises(SandboxError, match=r"wrote more than 32 MiB of files"):
         worker.call("children", "hold_deleted", (48, how, 3.0), {})
 
